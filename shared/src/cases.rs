@@ -1,0 +1,1 @@
+//! Canonical cases with known answers.

@@ -1,0 +1,38 @@
+//! `kapitza-core`: the physics of a pendulum whose pivot is shaken along a tilted line, its
+//! stability theory and the numerics that support them. `no_std`, tested on the host.
+//!
+//! # Module map
+//!
+//! | module | concept |
+//! |---|---|
+//! | [`math`] | the one place float functions come from (libm), angle wrapping |
+//! | [`error`] | parameter errors raised at the boundary of the API |
+//! | [`model`] | geometry → equivalent length, drive, dimensionless groups, equations of motion, equilibria of the averaged motion, R inferred from a settled angle |
+//! | [`stability`] | the four levels of stability theory: averaging, Mathieu series, harmonic balance, Floquet |
+//! | [`integrate`] | the `System` trait, work statistics, fixed-step RK4 |
+//! | [`poly`] | small real polynomials: arithmetic and robust real-root isolation |
+//! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
+//!
+//! # Conventions (SPEC §2–3)
+//!
+//! ```text
+//! angles from the downward vertical, counter-clockwise positive; θ = 0 hangs, θ = π inverted
+//! pivot:  r_p(t) = A cos(ωt) · (sin θd, −cos θd)
+//! full:   θ'' = −(g/ℓ) sin θ − (A ω²/ℓ) sin(θ − θd) cos(ωt) − c θ'
+//! groups: ω0 = √(g/ℓ),  R = A²ω²/(2gℓ),  ωc = √(2gℓ)/A,  m = A/ℓ,  k = ±g/(ℓω²),  Q = ω0/c
+//! ```
+//! SI units and radians throughout; degrees only at the user interface.
+#![cfg_attr(not(test), no_std)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod cases;
+pub mod error;
+pub mod integrate;
+pub mod math;
+pub mod model;
+pub mod poly;
+pub mod stability;
+
+pub use error::ParamError;

@@ -1,0 +1,1 @@
+//! The pendulum model: geometry, drive, dimensionless groups, equations of motion, equilibria.

@@ -1,0 +1,1 @@
+//! Stability theory (SPEC §4).
