@@ -15,7 +15,11 @@ pub struct ParamError {
 
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} = {} is out of range: allowed {}", self.name, self.value, self.allowed)
+        write!(
+            f,
+            "{} = {} is out of range: allowed {}",
+            self.name, self.value, self.allowed
+        )
     }
 }
 
@@ -27,7 +31,11 @@ pub fn positive(name: &'static str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(ParamError { name, value, allowed: "a finite number > 0" })
+        Err(ParamError {
+            name,
+            value,
+            allowed: "a finite number > 0",
+        })
     }
 }
 
@@ -36,7 +44,11 @@ pub fn non_negative(name: &'static str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(ParamError { name, value, allowed: "a finite number >= 0" })
+        Err(ParamError {
+            name,
+            value,
+            allowed: "a finite number >= 0",
+        })
     }
 }
 
@@ -45,7 +57,11 @@ pub fn finite(name: &'static str, value: f64) -> Result<f64, ParamError> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(ParamError { name, value, allowed: "a finite number" })
+        Err(ParamError {
+            name,
+            value,
+            allowed: "a finite number",
+        })
     }
 }
 

@@ -1,0 +1,78 @@
+//! The drive: the pivot moves as `r_p(t) = A cos(ωt) · (sin θd, −cos θd)` (SPEC §2).
+
+use crate::error::{finite, non_negative, positive, ParamError};
+use crate::math;
+
+/// The drive angle θd with its sine and cosine, exact at multiples of 90° when built from degrees.
+///
+/// The special cases of SPEC §3 (θd = 0°, 90°, 180°) are exact symmetries; computing sin(π) in
+/// floating point gives 1.2e-16 instead of 0 and breaks them, so the pair is kept alongside.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriveAngle {
+    rad: f64,
+    sin: f64,
+    cos: f64,
+}
+
+impl DriveAngle {
+    pub fn from_deg(deg: f64) -> Result<Self, ParamError> {
+        let deg = finite("drive angle", deg)?;
+        let (sin, cos) = math::sin_cos_deg(deg);
+        Ok(Self {
+            rad: math::wrap_pi(math::to_rad(deg)),
+            sin,
+            cos,
+        })
+    }
+
+    pub fn from_rad(rad: f64) -> Result<Self, ParamError> {
+        let rad = finite("drive angle", rad)?;
+        let (sin, cos) = math::sin_cos(rad);
+        Ok(Self {
+            rad: math::wrap_pi(rad),
+            sin,
+            cos,
+        })
+    }
+
+    /// θd in radians, wrapped to (−π, π].
+    pub fn rad(&self) -> f64 {
+        self.rad
+    }
+    pub fn deg(&self) -> f64 {
+        math::to_deg(self.rad)
+    }
+    pub fn sin(&self) -> f64 {
+        self.sin
+    }
+    pub fn cos(&self) -> f64 {
+        self.cos
+    }
+    /// (sin 2θd, cos 2θd), exact whenever sin θd and cos θd are.
+    pub fn sin_cos_2(&self) -> (f64, f64) {
+        (
+            2.0 * self.sin * self.cos,
+            self.cos * self.cos - self.sin * self.sin,
+        )
+    }
+}
+
+/// The shaking of the pivot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drive {
+    /// A: half the peak-to-peak stroke (m).
+    pub amplitude: f64,
+    /// ω (rad/s).
+    pub omega: f64,
+    pub angle: DriveAngle,
+}
+
+impl Drive {
+    pub fn new(amplitude: f64, omega: f64, angle: DriveAngle) -> Result<Self, ParamError> {
+        Ok(Self {
+            amplitude: non_negative("amplitude", amplitude)?,
+            omega: positive("omega", omega)?,
+            angle,
+        })
+    }
+}
