@@ -1,0 +1,79 @@
+//! The command line: parse, dispatch, and one error type that knows its exit status.
+
+use clap::{Parser, Subcommand};
+use std::ffi::OsString;
+use std::io::Write;
+use std::process::ExitCode;
+
+use crate::cmd;
+
+/// Software for the Kapitza shaker rig: predict equilibria and stability of a pendulum whose
+/// pivot is shaken along a tilted line.
+#[derive(Debug, Parser)]
+#[command(name = "kapitza", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    Predict(cmd::predict::Args),
+    Boundary(cmd::boundary::Args),
+}
+
+/// What went wrong, and how the process should exit.
+#[derive(Debug)]
+pub enum Error {
+    /// Bad command-line syntax, or `--help`/`--version` (clap prints and picks the status).
+    Usage(clap::Error),
+    /// Well-formed arguments with a value out of range, or a failure while running.
+    Run(anyhow::Error),
+}
+
+impl Error {
+    /// Prints the error (to stderr) and returns the exit status: 2 for usage errors as clap does,
+    /// 1 for anything else, 0 for `--help`.
+    pub fn report(&self) -> ExitCode {
+        match self {
+            Self::Usage(e) => {
+                let _ = e.print();
+                ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
+            }
+            Self::Run(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::from(1)
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Usage(e) => write!(f, "{e}"),
+            Self::Run(e) => write!(f, "{e:#}"),
+        }
+    }
+}
+
+impl From<anyhow::Error> for Error {
+    fn from(e: anyhow::Error) -> Self {
+        Self::Run(e)
+    }
+}
+
+/// Parses `args` (the first is the program name) and runs the command, writing its output to
+/// `out`.
+pub fn run<I, T>(args: I, out: &mut dyn Write) -> Result<(), Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = Cli::try_parse_from(args).map_err(Error::Usage)?;
+    match cli.command {
+        Command::Predict(a) => cmd::predict::run(&a, out)?,
+        Command::Boundary(a) => cmd::boundary::run(&a, out)?,
+    }
+    Ok(())
+}

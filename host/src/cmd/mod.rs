@@ -1,0 +1,4 @@
+//! One module per subcommand: its arguments (doc comments are the help text) and `run()`.
+
+pub mod boundary;
+pub mod predict;
