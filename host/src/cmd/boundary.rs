@@ -1,9 +1,433 @@
-//! `kapitza boundary`: placeholder until the stability API lands.
+//! `kapitza boundary`: the stability window in m = A/ℓ from every criterion of SPEC §4, each
+//! with its difference from Floquet and its measured cost.
 
-/// Stability window in m = A/ℓ from every criterion.
+use anyhow::{bail, Result};
+use serde::Serialize;
+use std::io::Write;
+use std::time::Duration;
+
+use crate::input::{self, GeometryArgs};
+use crate::timing::seconds_per_eval;
+use kapitza_core::model::Groups;
+use kapitza_core::stability::{
+    averaging, floquet::Floquet, harmonic_balance, mathieu, End, Window, K_MAX,
+};
+
+/// Subharmonic orders reported (n = 2 is the flutter boundary).
+const ORDERS: std::ops::RangeInclusive<u32> = 2..=8;
+/// Length of one timing batch.
+const BATCH: Duration = Duration::from_millis(20);
+
+/// Stability window in m = A/ℓ of the hanging or inverted position, from every criterion.
+///
+/// Give the signed k of the linearised equation x'' + c x' + ω²(k − m cos ωt) x = 0 (negative
+/// about the inverted position, positive about the hanging one), or a pendulum and drive
+/// frequency (--rod/--point with --omega; the inverted position unless --hanging), which also
+/// gives the window as amplitudes A in metres. Only Floquet includes damping; the other
+/// criteria report their undamped value and say so.
 #[derive(Debug, Clone, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Signed k = ±(ω0/ω)²: < 0 about the inverted position, > 0 about the hanging one.
+    #[arg(long, value_name = "K", allow_negative_numbers = true,
+          required_unless_present_any = ["rod", "point"],
+          conflicts_with_all = ["rod", "point", "omega", "damping", "hanging"])]
+    pub k: Option<f64>,
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
+    /// Drive angular frequency ω (rad/s). With --rod or --point.
+    #[arg(long, value_name = "W", allow_negative_numbers = true)]
+    pub omega: Option<f64>,
+    /// Gravity g (m/s²). With --rod or --point.
+    #[arg(
+        long,
+        value_name = "G",
+        default_value_t = 9.81,
+        allow_negative_numbers = true
+    )]
+    pub gravity: f64,
+    /// Study the hanging position (k > 0) instead of the inverted one. With --rod or --point.
+    #[arg(long)]
+    pub hanging: bool,
+    /// Damping coefficient c (1/s) of the term c θ'. With --rod or --point.
+    #[arg(
+        long,
+        value_name = "C",
+        conflicts_with = "quality",
+        allow_negative_numbers = true
+    )]
+    pub damping: Option<f64>,
+    /// Quality factor Q = ω0/c of the damping (δ = c/ω = √|k|/Q).
+    #[arg(
+        long = "q",
+        id = "quality",
+        value_name = "Q",
+        allow_negative_numbers = true
+    )]
+    pub quality: Option<f64>,
+    /// Floquet: tolerance on each boundary in m.
+    #[arg(long, value_name = "TOL", default_value_t = 1e-7)]
+    pub tol: f64,
+    /// Floquet: RK4 steps per drive period of each monodromy matrix.
+    #[arg(long, value_name = "N", default_value_t = kapitza_core::stability::floquet::DEFAULT_STEPS)]
+    pub steps: u32,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
 
-pub fn run(_args: &Args, _out: &mut dyn std::io::Write) -> anyhow::Result<()> {
-    anyhow::bail!("not yet")
+/// The `--json` output.
+#[derive(Debug, Serialize)]
+pub struct Report {
+    pub k: f64,
+    pub position: &'static str,
+    /// δ = c/ω: damping per radian of drive phase.
+    pub delta: f64,
+    pub physical: Option<Physical>,
+    pub criteria: Vec<Criterion>,
+    pub subharmonics: Vec<Subharmonic>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct Physical {
+    pub equivalent_length: f64,
+    pub omega: f64,
+    pub omega0: f64,
+    pub gravity: f64,
+    pub damping_c: f64,
+}
+
+#[derive(Debug, Serialize)]
+pub struct Criterion {
+    pub name: &'static str,
+    pub lower_m: Option<f64>,
+    pub upper_m: Option<f64>,
+    /// Why an end is null.
+    pub lower_reason: Option<&'static str>,
+    pub upper_reason: Option<&'static str>,
+    /// The ends as pivot amplitudes A = m ℓ in metres (with a pendulum).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lower_amplitude: Option<Option<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub upper_amplitude: Option<Option<f64>>,
+    /// This criterion's end minus Floquet's (null where either is missing).
+    pub lower_diff_from_floquet: Option<f64>,
+    pub upper_diff_from_floquet: Option<f64>,
+    /// Measured wall time of one evaluation of this criterion's window (both ends), median of 5.
+    pub seconds_per_eval: f64,
+    pub includes_damping: bool,
+    /// How far to trust the values (e.g. the Mathieu series used outside its range, or an
+    /// undamped value beside a damped reference).
+    pub notes: Vec<&'static str>,
+    /// Harmonic balance only: the truncated (A5 dropped) flutter formula.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub upper_m_truncated: Option<f64>,
+    /// Floquet only: monodromy matrices and right-hand-side evaluations one window took.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub monodromies: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rhs_evals: Option<u64>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct Subharmonic {
+    pub order: u32,
+    /// Harmonic balance (5×5 determinant; n = 2: the 3×3 flutter boundary).
+    pub m: Option<f64>,
+    /// Floquet: where tr M = 2 cos(2π/n), undamped.
+    pub m_floquet: Option<f64>,
+    pub reason: Option<&'static str>,
+    pub reason_floquet: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amplitude: Option<Option<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amplitude_floquet: Option<Option<f64>>,
+}
+
+/// The linearised problem to study.
+struct Problem {
+    k: f64,
+    delta: f64,
+    physical: Option<Physical>,
+}
+
+pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    let report = compute(args)?;
+    if args.json {
+        serde_json::to_writer_pretty(&mut *out, &report)?;
+        writeln!(out)?;
+    } else {
+        print_table(&report, out)?;
+    }
+    Ok(())
+}
+
+fn problem(args: &Args) -> Result<Problem> {
+    let quality = args
+        .quality
+        .map(|q| input::positive("--q", q))
+        .transpose()?;
+    if let Some(k) = args.k {
+        let k = input::finite("--k", k)?;
+        if k.abs() > K_MAX {
+            bail!("--k {k} is out of range: expected |k| <= {K_MAX}");
+        }
+        // δ = c/ω and Q = ω0/c with ω0/ω = √|k|: δ = √|k|/Q.
+        let delta = quality.map_or(0.0, |q| k.abs().sqrt() / q);
+        return Ok(Problem {
+            k,
+            delta,
+            physical: None,
+        });
+    }
+    let Some(geometry) = args.geometry.geometry()? else {
+        bail!("give --k K, or a pendulum (--rod L or --point l) with --omega W");
+    };
+    let Some(omega) = args.omega else {
+        bail!("--rod/--point need --omega W (rad/s)");
+    };
+    let omega = input::positive("--omega", omega)?;
+    let gravity = input::positive("--gravity", args.gravity)?;
+    let ell = geometry.equivalent_length();
+    let omega0 = (gravity / ell).sqrt();
+    let c = match (args.damping, quality) {
+        (Some(c), _) => input::non_negative("--damping", c)?,
+        (None, Some(q)) => omega0 / q,
+        (None, None) => 0.0,
+    };
+    // The amplitude only scales m; any positive value gives the same k and δ.
+    let g = Groups::new(ell, gravity, ell, omega, c)?;
+    let k = g.k(!args.hanging);
+    if k.abs() > K_MAX {
+        bail!(
+            "(ω0/ω)² = {} is out of range: expected <= {K_MAX} (raise --omega)",
+            k.abs()
+        );
+    }
+    Ok(Problem {
+        k,
+        delta: g.delta(),
+        physical: Some(Physical {
+            equivalent_length: ell,
+            omega,
+            omega0,
+            gravity,
+            damping_c: c,
+        }),
+    })
+}
+
+pub fn compute(args: &Args) -> Result<Report> {
+    let p = problem(args)?;
+    let tol = input::positive("--tol", args.tol)?;
+    if args.steps == 0 {
+        bail!("--steps 0 is out of range: expected at least 1");
+    }
+    let floquet = Floquet::new(args.steps)?;
+    let (k, delta) = (p.k, p.delta);
+    let ell = p.physical.as_ref().map(|ph| ph.equivalent_length);
+    let undamped = (delta > 0.0).then_some("undamped value: only Floquet includes damping");
+
+    let fw = floquet.window(k, delta, tol)?;
+    let f_cost = seconds_per_eval(BATCH, || floquet.window(k, delta, tol));
+    let reference = fw.value;
+
+    let mut criteria = vec![
+        criterion(
+            "averaging",
+            averaging::window(k)?,
+            &reference,
+            ell,
+            undamped,
+            seconds_per_eval(BATCH, || averaging::window(k)),
+        ),
+        criterion(
+            "mathieu",
+            mathieu::window(k)?,
+            &reference,
+            ell,
+            undamped,
+            seconds_per_eval(BATCH, || mathieu::window(k)),
+        ),
+        criterion(
+            "harmonic_balance",
+            harmonic_balance::window(k)?,
+            &reference,
+            ell,
+            undamped,
+            seconds_per_eval(BATCH, || harmonic_balance::window(k)),
+        ),
+    ];
+    criteria[2].upper_m_truncated = harmonic_balance::truncated_upper(k)?.value();
+    let mut f = criterion("floquet", reference, &reference, ell, None, f_cost);
+    f.includes_damping = true;
+    f.monodromies = Some(fw.monodromies);
+    f.rhs_evals = Some(fw.stats.rhs_evals);
+    criteria.push(f);
+
+    let mut subharmonics = Vec::new();
+    for n in ORDERS {
+        let hb = harmonic_balance::subharmonic_m(k, n)?;
+        let fl = floquet.subharmonic_m(k, n, tol)?.value;
+        subharmonics.push(Subharmonic {
+            order: n,
+            m: hb.value(),
+            m_floquet: fl.value(),
+            reason: reason(hb),
+            reason_floquet: reason(fl),
+            amplitude: ell.map(|l| hb.value().map(|m| m * l)),
+            amplitude_floquet: ell.map(|l| fl.value().map(|m| m * l)),
+        });
+    }
+    let position = if k < 0.0 { "inverted" } else { "hanging" };
+    Ok(Report {
+        k,
+        position,
+        delta,
+        physical: p.physical,
+        criteria,
+        subharmonics,
+    })
+}
+
+fn reason(e: End) -> Option<&'static str> {
+    match e {
+        End::Value(_) => None,
+        End::Missing(why) => Some(why),
+    }
+}
+
+fn criterion(
+    name: &'static str,
+    w: Window,
+    floquet: &Window,
+    ell: Option<f64>,
+    undamped: Option<&'static str>,
+    seconds_per_eval: f64,
+) -> Criterion {
+    let diff = |a: End, b: End| a.value().zip(b.value()).map(|(a, b)| a - b);
+    Criterion {
+        name,
+        lower_m: w.lower.value(),
+        upper_m: w.upper.value(),
+        lower_reason: reason(w.lower),
+        upper_reason: reason(w.upper),
+        lower_amplitude: ell.map(|l| w.lower.value().map(|m| m * l)),
+        upper_amplitude: ell.map(|l| w.upper.value().map(|m| m * l)),
+        lower_diff_from_floquet: diff(w.lower, floquet.lower),
+        upper_diff_from_floquet: diff(w.upper, floquet.upper),
+        seconds_per_eval,
+        includes_damping: false,
+        notes: w.note.into_iter().chain(undamped).collect(),
+        upper_m_truncated: None,
+        monodromies: None,
+        rhs_evals: None,
+    }
+}
+
+fn fmt_opt(x: Option<f64>, prec: usize) -> String {
+    x.map_or("—".into(), |v| format!("{v:.prec$}"))
+}
+
+fn fmt_diff(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:+.2e}"))
+}
+
+fn fmt_seconds(s: f64) -> String {
+    match s {
+        s if s < 1e-6 => format!("{:.0} ns", s * 1e9),
+        s if s < 1e-3 => format!("{:.1} µs", s * 1e6),
+        s => format!("{:.1} ms", s * 1e3),
+    }
+}
+
+fn print_table(r: &Report, out: &mut dyn Write) -> Result<()> {
+    if let Some(p) = &r.physical {
+        writeln!(
+            out,
+            "pendulum: ℓ = {:.4} m, ω = {} rad/s, ω0 = {:.3} rad/s, c = {:.4} 1/s",
+            p.equivalent_length, p.omega, p.omega0, p.damping_c
+        )?;
+    }
+    let delta = if r.delta == 0.0 {
+        "0 (undamped)".into()
+    } else {
+        format!("{:.3e}", r.delta)
+    };
+    writeln!(
+        out,
+        "{} position: k = {:.6}, δ = c/ω = {delta}",
+        r.position, r.k
+    )?;
+    writeln!(
+        out,
+        "{:<17} {:>10} {:>10} {:>11} {:>11} {:>10}",
+        "criterion", "lower m", "upper m", "Δlower", "Δupper", "cost/eval"
+    )?;
+    let mut notes = Vec::new();
+    for c in &r.criteria {
+        writeln!(
+            out,
+            "{:<17} {:>10} {:>10} {:>11} {:>11} {:>10}",
+            c.name,
+            fmt_opt(c.lower_m, 6),
+            fmt_opt(c.upper_m, 6),
+            fmt_diff(c.lower_diff_from_floquet),
+            fmt_diff(c.upper_diff_from_floquet),
+            fmt_seconds(c.seconds_per_eval)
+        )?;
+        for (end, why) in [("lower", c.lower_reason), ("upper", c.upper_reason)] {
+            if let Some(why) = why {
+                notes.push(format!("  {} {end}: {why}", c.name));
+            }
+        }
+        for why in &c.notes {
+            let prefix = format!("{}: ", c.name);
+            notes.push(format!(
+                "  {}: {}",
+                c.name,
+                why.strip_prefix(prefix.as_str()).unwrap_or(why)
+            ));
+        }
+        if let (Some(p), Some(lo)) = (&r.physical, c.lower_m) {
+            let up = c.upper_m.map_or("—".into(), |u| {
+                format!("{:.3} mm", u * p.equivalent_length * 1e3)
+            });
+            notes.push(format!(
+                "  {} as amplitude A: {:.3} mm … {up}",
+                c.name,
+                lo * p.equivalent_length * 1e3
+            ));
+        }
+    }
+    if let Some(t) = r.criteria.iter().find_map(|c| c.upper_m_truncated) {
+        notes.push(format!(
+            "  harmonic_balance upper, truncated formula: {t:.6}"
+        ));
+    }
+    writeln!(out, "(Δ: criterion minus Floquet)")?;
+    for n in &notes {
+        writeln!(out, "{n}")?;
+    }
+    writeln!(out, "order-n subharmonic thresholds in m (undamped):")?;
+    writeln!(
+        out,
+        "{:>5} {:>17} {:>10} {:>11}",
+        "n", "harmonic balance", "Floquet", "Δ"
+    )?;
+    for s in &r.subharmonics {
+        let d = s.m.zip(s.m_floquet).map(|(a, b)| a - b);
+        let why = s
+            .reason_floquet
+            .or(s.reason)
+            .map_or(String::new(), |w| format!("  ({w})"));
+        writeln!(
+            out,
+            "{:>5} {:>17} {:>10} {:>11}{why}",
+            s.order,
+            fmt_opt(s.m, 6),
+            fmt_opt(s.m_floquet, 6),
+            fmt_diff(d)
+        )?;
+    }
+    Ok(())
 }

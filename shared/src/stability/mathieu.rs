@@ -53,7 +53,7 @@ pub const Q_VALID: f64 = 1.0;
 
 /// Note for a window end found at q > [`Q_VALID`].
 pub const OUTSIDE_RANGE: &str =
-    "Mathieu series used outside its range |q| <= 1: expect errors of 1e-2 or more in a";
+    "Mathieu series used outside its range |q| <= 1: expect errors of 1e-2 or more in m";
 /// Reason for a missing end when the truncated series never reaches a = 4k.
 pub const NO_CROSSING: &str = "the truncated Mathieu series never reaches a = 4k for q <= 50";
 /// Reason for missing ends when the series' curves cross before a window opens.
