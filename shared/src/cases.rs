@@ -23,7 +23,10 @@ const fn printed(value: f64, decimals: i32) -> Printed {
         half /= 10.0;
         i += 1;
     }
-    Printed { value, half_ulp: half }
+    Printed {
+        value,
+        half_ulp: half,
+    }
 }
 
 /// Stability boundaries in m = A/ℓ at one signed k (point-mass form), as printed in SPEC §4.
@@ -83,8 +86,13 @@ pub struct RodCase {
 }
 
 /// Rod L = 0.25 m, A = 0.0127 m, ω = 188 rad/s, g = 9.81 → R = 1.7433 (printed as ≈ 1.75).
-pub const DEMO_ROD: RodCase =
-    RodCase { length: 0.25, amplitude: 0.0127, omega: 188.0, gravity: 9.81, r: printed(1.7433, 4) };
+pub const DEMO_ROD: RodCase = RodCase {
+    length: 0.25,
+    amplitude: 0.0127,
+    omega: 188.0,
+    gravity: 9.81,
+    r: printed(1.7433, 4),
+};
 
 /// A stable tilted equilibrium of the averaged motion.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,8 +103,11 @@ pub struct TiltCase {
 }
 
 /// R = 1.75, θd = 90° → φ0 = arccos(1/R) = 55.15°.
-pub const HORIZONTAL_1_75: TiltCase =
-    TiltCase { r: 1.75, drive_angle_deg: 90.0, stable_deg: printed(55.15, 2) };
+pub const HORIZONTAL_1_75: TiltCase = TiltCase {
+    r: 1.75,
+    drive_angle_deg: 90.0,
+    stable_deg: printed(55.15, 2),
+};
 
 /// Landau & Lifshitz's lower bound on the pivot amplitude for a point mass: g = 9.81, l = 1 m,
 /// ω = 9 rad/s, no damping → amplitude a > √(2g/l)·l/ω = 0.492 m.
@@ -108,8 +119,12 @@ pub struct LandauCase {
     pub lower_amplitude: Printed,
 }
 
-pub const LANDAU: LandauCase =
-    LandauCase { gravity: 9.81, length: 1.0, omega: 9.0, lower_amplitude: printed(0.492, 3) };
+pub const LANDAU: LandauCase = LandauCase {
+    gravity: 9.81,
+    length: 1.0,
+    omega: 9.0,
+    lower_amplitude: printed(0.492, 3),
+};
 
 #[cfg(test)]
 mod tests {
