@@ -93,6 +93,29 @@ pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
     }
 }
 
+/// The root of a continuous f in (a, b), given f(a) = `fa` and a sign change between a and b,
+/// bisected to adjacent floats (at most ~2100 halvings, even for a root at subnormal scale).
+/// Both root finders use it: [`crate::poly`] and [`crate::model::trig`].
+pub fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, fa: f64) -> f64 {
+    let neg_at_a = fa < 0.0;
+    for _ in 0..2200 {
+        let mid = a + 0.5 * (b - a);
+        if mid <= a || mid >= b {
+            break;
+        }
+        let fm = f(mid);
+        if fm == 0.0 {
+            return mid;
+        }
+        if (fm < 0.0) == neg_at_a {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    a + 0.5 * (b - a)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -210,26 +210,8 @@ impl Poly {
     }
 
     /// The root of p in (a, b), where p is monotone and changes sign; `fa` = p(a).
-    fn bisect(&self, mut a: f64, mut b: f64, fa: f64) -> f64 {
-        let neg_at_a = fa < 0.0;
-        // Bisection to adjacent floats: ≤ ~2100 halvings even for a root at subnormal scale;
-        // the cap is a guard, never reached for a finite interval.
-        for _ in 0..2200 {
-            let mid = a + 0.5 * (b - a);
-            if mid <= a || mid >= b {
-                break;
-            }
-            let fm = self.eval(mid);
-            if fm == 0.0 {
-                return mid;
-            }
-            if (fm < 0.0) == neg_at_a {
-                a = mid;
-            } else {
-                b = mid;
-            }
-        }
-        a + 0.5 * (b - a)
+    fn bisect(&self, a: f64, b: f64, fa: f64) -> f64 {
+        crate::math::bisect(|x| self.eval(x), a, b, fa)
     }
 }
 

@@ -184,24 +184,8 @@ impl TrigPoly2 {
     }
 
     /// Bisection to the last representable bit: p(lo) has sign of `plo`, p(hi) the other sign.
-    fn bisect(&self, mut lo: f64, mut hi: f64, plo: f64) -> f64 {
-        let lo_negative = plo < 0.0;
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            let pm = self.eval(mid);
-            if pm == 0.0 {
-                return mid;
-            }
-            if (pm < 0.0) == lo_negative {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        0.5 * (lo + hi)
+    fn bisect(&self, lo: f64, hi: f64, plo: f64) -> f64 {
+        math::bisect(|x| self.eval(x), lo, hi, plo)
     }
 }
 
