@@ -11,6 +11,7 @@
 //! | [`stability`] | the four levels of stability theory: averaging, Mathieu series, harmonic balance, Floquet |
 //! | [`integrate`] | the `System` trait, work statistics, fixed-step RK4 |
 //! | [`poly`] | small real polynomials: arithmetic and robust real-root isolation |
+//! | [`real`] | the number formats (f64, f32) behind one trait, math through libm |
 //! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
 //!
 //! # Conventions (SPEC §2–3)
@@ -33,6 +34,8 @@ pub mod integrate;
 pub mod math;
 pub mod model;
 pub mod poly;
+pub mod real;
 pub mod stability;
 
 pub use error::ParamError;
+pub use real::Real;

@@ -6,10 +6,16 @@ mod rk4;
 
 pub use rk4::{rk4_fixed, rk4_step};
 
-/// A first-order system y' = f(t, y) with an N-dimensional state held in a fixed array.
-pub trait System<const N: usize> {
+use crate::Real;
+
+/// A first-order system y' = f(t, y) with an N-dimensional state in the number format `R`.
+///
+/// Time is always f64: it is bookkeeping computed as t0 + i·h, never accumulated, and an f32
+/// clock would lose the drive phase within minutes of simulated time (ulp(3600 s) ≈ 0.24 ms in
+/// f32, 0.08 rad at ω = 330 rad/s).
+pub trait System<const N: usize, R: Real = f64> {
     /// Writes f(t, y) into `dy`.
-    fn rhs(&self, t: f64, y: &[f64; N], dy: &mut [f64; N]);
+    fn rhs(&self, t: f64, y: &[R; N], dy: &mut [R; N]);
 }
 
 /// The work an integration did.

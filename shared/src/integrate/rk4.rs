@@ -1,36 +1,39 @@
 //! The classical fourth-order Runge–Kutta method with a fixed step.
 
 use super::{Stats, System};
+use crate::Real;
 
 /// One RK4 step of size `h` from (t, y); four right-hand-side evaluations.
-pub fn rk4_step<S: System<N>, const N: usize>(
+pub fn rk4_step<S: System<N, R>, R: Real, const N: usize>(
     sys: &S,
     t: f64,
-    y: &[f64; N],
+    y: &[R; N],
     h: f64,
     stats: &mut Stats,
-) -> [f64; N] {
-    let mut k1 = [0.0; N];
-    let mut k2 = [0.0; N];
-    let mut k3 = [0.0; N];
-    let mut k4 = [0.0; N];
-    let mut tmp = [0.0; N];
+) -> [R; N] {
+    let mut k1 = [R::ZERO; N];
+    let mut k2 = [R::ZERO; N];
+    let mut k3 = [R::ZERO; N];
+    let mut k4 = [R::ZERO; N];
+    let mut tmp = [R::ZERO; N];
+    let (hr, half, sixth) = (R::from_f64(h), R::from_f64(0.5 * h), R::from_f64(h / 6.0));
+    let two = R::from_f64(2.0);
     sys.rhs(t, y, &mut k1);
     for i in 0..N {
-        tmp[i] = y[i] + 0.5 * h * k1[i];
+        tmp[i] = y[i] + half * k1[i];
     }
     sys.rhs(t + 0.5 * h, &tmp, &mut k2);
     for i in 0..N {
-        tmp[i] = y[i] + 0.5 * h * k2[i];
+        tmp[i] = y[i] + half * k2[i];
     }
     sys.rhs(t + 0.5 * h, &tmp, &mut k3);
     for i in 0..N {
-        tmp[i] = y[i] + h * k3[i];
+        tmp[i] = y[i] + hr * k3[i];
     }
     sys.rhs(t + h, &tmp, &mut k4);
-    let mut out = [0.0; N];
+    let mut out = [R::ZERO; N];
     for i in 0..N {
-        out[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        out[i] = y[i] + sixth * (k1[i] + two * k2[i] + two * k3[i] + k4[i]);
     }
     stats.steps += 1;
     stats.rhs_evals += 4;
@@ -39,14 +42,14 @@ pub fn rk4_step<S: System<N>, const N: usize>(
 
 /// Integrates from `t0` to `t1` in `n` equal steps. Step times are `t0 + i·h`, computed afresh
 /// each step rather than accumulated, so rounding does not build up over long runs.
-pub fn rk4_fixed<S: System<N>, const N: usize>(
+pub fn rk4_fixed<S: System<N, R>, R: Real, const N: usize>(
     sys: &S,
     t0: f64,
-    y0: [f64; N],
+    y0: [R; N],
     t1: f64,
     n: u32,
     stats: &mut Stats,
-) -> [f64; N] {
+) -> [R; N] {
     let n = n.max(1);
     let h = (t1 - t0) / f64::from(n);
     let mut y = y0;
