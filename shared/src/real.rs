@@ -41,6 +41,10 @@ pub trait Real:
     fn abs(self) -> Self;
     fn is_finite(self) -> bool;
 
+    /// (sin ϕ, cos ϕ) of a drive phase kept in f64. f64 evaluates it directly; f32 first
+    /// reduces ϕ to (−π, π] in f64, since the phase grows without bound and f32 would lose it.
+    fn sin_cos_phase(phase: f64) -> (Self, Self);
+
     fn max(self, other: Self) -> Self {
         if self > other {
             self
@@ -99,6 +103,10 @@ impl Real for f64 {
     fn is_finite(self) -> bool {
         f64::is_finite(self)
     }
+    #[inline]
+    fn sin_cos_phase(phase: f64) -> (Self, Self) {
+        libm::sincos(phase)
+    }
 }
 
 impl Real for f32 {
@@ -142,6 +150,10 @@ impl Real for f32 {
     #[inline]
     fn is_finite(self) -> bool {
         f32::is_finite(self)
+    }
+    #[inline]
+    fn sin_cos_phase(phase: f64) -> (Self, Self) {
+        libm::sincosf(crate::math::wrap_pi(phase) as f32)
     }
 }
 

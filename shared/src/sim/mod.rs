@@ -1,0 +1,30 @@
+//! The simulator: scenes, the equations they compose, and what the pendulum ends up doing.
+//!
+//! | module | concept |
+//! |---|---|
+//! | [`scene`] | one experiment in SI units, checked once |
+//! | [`signal`] | the drive: pivot acceleration and phase, with ramp, motor lag, slider-crank |
+//! | [`eom`] | full, averaged and linearised equations, composed from the listed effects |
+//! | [`fidelity`] | which equation a scene runs (`auto`: the cheapest valid one) and why |
+//! | [`classify`] | the outcome from stroboscopic samples |
+//! | [`sampling`] | strobes, period means, output and sensor samples between steps |
+//! | [`sensor`] | the pivot encoder: sampled, noisy, quantised |
+//! | [`friction`] | Coulomb stick–slip as switched smooth segments |
+//! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
+//! | [`run`] | `simulate`: compose, integrate, sample, classify |
+
+pub mod classify;
+pub mod eom;
+pub mod fidelity;
+mod friction;
+mod lyapunov;
+pub mod run;
+pub mod sampling;
+pub mod scene;
+pub mod sensor;
+pub mod signal;
+
+pub use classify::Outcome;
+pub use run::{simulate, Format, Method, Options, Report, SimError};
+pub use sampling::Recorder;
+pub use scene::Scene;

@@ -1,0 +1,480 @@
+//! Running a scene: choose the equation, compose it from the listed effects, integrate, sample,
+//! classify.
+//!
+//! The equation is built once, as a concrete type, before the loop starts: the drive signal
+//! ([`Steady`] or [`Shaped`]), the extra forces ([`NoExtra`] or [`Viscous`]) and the number format
+//! are type parameters, so the inner loop of a scene carries no test or evaluation for an effect
+//! it does not list. Coulomb friction switches between sliding segments and sticking, so it has
+//! its own loop ([`super::friction`]).
+
+use super::classify::{self, Outcome};
+use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
+use super::fidelity::{self, Decision, FidelityError};
+use super::friction;
+use super::lyapunov;
+use super::sampling::{Hermite, Interpolant, Recorder, Sampler};
+use super::scene::{Fidelity, Physical, Scene, SceneError};
+use super::sensor::Encoder;
+use super::signal::{DriveSignal, Schedule, Shaped, Steady};
+use crate::integrate::{
+    rk4_observe, Control, Dop853, IntegrateError, Stats, Step, StepControl, System,
+};
+use crate::{math, Real};
+use core::fmt;
+
+/// How to integrate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Classical RK4 with a fixed step of T/steps_per_period (T: the set-point drive period).
+    Rk4 { steps_per_period: f64 },
+    /// Adaptive Dormand–Prince 8(5,3) with dense output.
+    Dop853 { rtol: f64, atol: f64 },
+}
+
+impl Method {
+    /// The default: DOP853 at rtol = atol = 1e-9.
+    pub const DEFAULT: Method = Method::Dop853 {
+        rtol: 1e-9,
+        atol: 1e-9,
+    };
+}
+
+/// The number format of the state and its arithmetic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    F64,
+    F32,
+}
+
+/// How to run a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    pub method: Method,
+    pub format: Format,
+    /// Output sample interval (s); 0 for none.
+    pub out_dt: f64,
+    /// Seed of the sensor's noise.
+    pub seed: u64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            method: Method::DEFAULT,
+            format: Format::F64,
+            out_dt: 0.0,
+            seed: 1,
+        }
+    }
+}
+
+/// What a run found and what it cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Report {
+    pub outcome: Outcome,
+    pub decision: Decision,
+    pub physical: Physical,
+    pub duration: f64,
+    /// Stroboscopic samples taken (drive periods completed).
+    pub strobes: u64,
+    /// Work of the run itself (including dense-output and interpolation evaluations).
+    pub work: Stats,
+    /// Work of the Lyapunov run, when the classifier needed one.
+    pub lyapunov_work: Stats,
+    /// Final time, angle (rad, unwrapped) and rate (rad/s).
+    pub end: (f64, f64, f64),
+    /// With Coulomb friction: how many times the pendulum stuck.
+    pub sticks: Option<u64>,
+}
+
+/// Why a run did not happen or did not finish.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SimError {
+    Scene(SceneError),
+    Fidelity(FidelityError),
+    Integrate(IntegrateError),
+    /// A method or option that cannot run this scene, with the reason.
+    Unsupported(&'static str),
+}
+
+impl fmt::Display for SimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SimError::Scene(e) => e.fmt(f),
+            SimError::Fidelity(e) => e.fmt(f),
+            SimError::Integrate(e) => write!(f, "integration failed: {e}"),
+            SimError::Unsupported(why) => f.write_str(why),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for SimError {}
+
+impl From<SceneError> for SimError {
+    fn from(e: SceneError) -> Self {
+        SimError::Scene(e)
+    }
+}
+impl From<FidelityError> for SimError {
+    fn from(e: FidelityError) -> Self {
+        SimError::Fidelity(e)
+    }
+}
+impl From<IntegrateError> for SimError {
+    fn from(e: IntegrateError) -> Self {
+        SimError::Integrate(e)
+    }
+}
+
+/// Everything a generic run needs besides the equation.
+pub(super) struct Context {
+    pub method: Method,
+    pub y0: (f64, f64),
+    pub t_end: f64,
+    pub schedule: Schedule,
+    pub strobes_total: u64,
+    pub out_dt: f64,
+    pub sensor: Option<Encoder>,
+    /// Drive period at the set point (s).
+    pub period: f64,
+    pub omega: f64,
+    pub undamped: bool,
+}
+
+/// The raw result of a generic run, before classification.
+pub(super) struct RunOut<'a, Rec: Recorder> {
+    pub sampler: Sampler<'a, Rec>,
+    pub work: Stats,
+    pub end: (f64, f64, f64),
+    pub sticks: Option<u64>,
+}
+
+/// Runs a scene and classifies the outcome.
+pub fn simulate<Rec: Recorder>(
+    scene: &Scene,
+    options: &Options,
+    rec: &mut Rec,
+) -> Result<Report, SimError> {
+    scene.check()?;
+    let p = scene.physical()?;
+    let decision = fidelity::decide(scene, &p)?;
+    check_method(scene, options)?;
+    match options.format {
+        Format::F64 => run_format::<f64, Rec>(scene, &p, decision, options, rec),
+        Format::F32 => run_format::<f32, Rec>(scene, &p, decision, options, rec),
+    }
+}
+
+fn check_method(scene: &Scene, options: &Options) -> Result<(), SimError> {
+    match options.method {
+        Method::Rk4 { steps_per_period } => {
+            if !(steps_per_period.is_finite() && steps_per_period > 0.0) {
+                return Err(SimError::Unsupported(
+                    "run.steps_per_period must be a finite number > 0",
+                ));
+            }
+            if scene.effects.coulomb.is_some() {
+                return Err(SimError::Unsupported(
+                    "Coulomb friction needs event location: use method = \"dop853\"",
+                ));
+            }
+        }
+        Method::Dop853 { rtol, atol } => {
+            if !(rtol.is_finite()
+                && atol.is_finite()
+                && rtol >= 0.0
+                && atol >= 0.0
+                && rtol + atol > 0.0)
+            {
+                return Err(SimError::Unsupported(
+                    "run.rtol and run.atol must be finite, >= 0, not both 0",
+                ));
+            }
+        }
+    }
+    if !(options.out_dt.is_finite() && options.out_dt >= 0.0) {
+        return Err(SimError::Unsupported(
+            "the output interval must be a finite number >= 0",
+        ));
+    }
+    Ok(())
+}
+
+/// The drive signal a scene needs: the steady sinusoid unless something shapes it.
+fn shaped(scene: &Scene) -> bool {
+    let e = &scene.effects;
+    e.ramp.is_some() || e.actuator.is_some() || e.slider_crank.is_some()
+}
+
+fn schedule(scene: &Scene, p: &Physical) -> Schedule {
+    Schedule {
+        omega: p.omega,
+        ramp: scene.effects.ramp,
+        lag: scene.effects.actuator,
+    }
+}
+
+/// a2/ℓ of the slider-crank's second harmonic, A²/(4b)/ℓ.
+fn second_harmonic(scene: &Scene, p: &Physical) -> f64 {
+    scene
+        .effects
+        .slider_crank
+        .map_or(0.0, |b| p.amplitude * p.amplitude / (4.0 * b) / p.ell)
+}
+
+fn run_format<R: Real, Rec: Recorder>(
+    scene: &Scene,
+    p: &Physical,
+    decision: Decision,
+    options: &Options,
+    rec: &mut Rec,
+) -> Result<Report, SimError> {
+    let sched = schedule(scene, p);
+    let t_end = scene.duration(p.omega);
+    let strobes_total = libm::floor(sched.state(t_end).phase / math::TAU) as u64;
+    let ctx = Context {
+        method: options.method,
+        y0: (scene.initial_angle, scene.initial_rate),
+        t_end,
+        schedule: sched,
+        strobes_total,
+        out_dt: options.out_dt,
+        sensor: scene.effects.sensor.map(|s| Encoder::new(s, options.seed)),
+        period: math::TAU / p.omega,
+        omega: p.omega,
+        undamped: p.c == 0.0 && scene.effects.coulomb.is_none(),
+    };
+    let a1 = p.amplitude / p.ell;
+    if shaped(scene) {
+        let sig = Shaped::<R>::new(a1, second_harmonic(scene, p), sched);
+        finish(scene, p, decision, sig, &ctx, rec)
+    } else {
+        finish(scene, p, decision, Steady::<R>::new(a1, p.omega), &ctx, rec)
+    }
+}
+
+/// Runs the composed equation, then classifies (running the Lyapunov pair only if asked).
+fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
+    scene: &Scene,
+    p: &Physical,
+    decision: Decision,
+    sig: D,
+    ctx: &Context,
+    rec: &mut Rec,
+) -> Result<Report, SimError> {
+    let out = match scene.effects.coulomb {
+        Some(mu) => {
+            let eom =
+                FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
+            friction::run(eom, R::from_f64(p.c), mu, ctx, rec)?
+        }
+        None => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
+    };
+    let RunOut {
+        sampler,
+        work,
+        end,
+        sticks,
+    } = out;
+    let mut lyapunov_work = Stats::default();
+    let outcome = classify::classify(&sampler.strobes, p.omega, ctx.undamped, || {
+        match (sampler.window_start, scene.effects.coulomb) {
+            (Some(start), None) => {
+                let (lambda, w) =
+                    with_equation(scene, p, decision, sig, lyapunov::Exponent { ctx, start });
+                lyapunov_work = w;
+                lambda
+            }
+            // The pair-of-trajectories estimate is not defined across stick–slip switches.
+            _ => 0.0,
+        }
+    });
+    Ok(Report {
+        outcome,
+        decision,
+        physical: *p,
+        duration: ctx.t_end,
+        strobes: ctx.strobes_total,
+        work,
+        lyapunov_work,
+        end,
+        sticks,
+    })
+}
+
+/// Something to do with a composed smooth equation.
+pub(super) trait Job<R: Real> {
+    type Out;
+    fn run<S: System<2, R> + Copy>(self, sys: S) -> Self::Out;
+}
+
+/// Builds the equation for the decided fidelity with exactly the listed forces, and hands it to
+/// `job`. Each arm is its own concrete type.
+pub(super) fn with_equation<R: Real, D: DriveSignal<R>, J: Job<R>>(
+    scene: &Scene,
+    p: &Physical,
+    decision: Decision,
+    sig: D,
+    job: J,
+) -> J::Out {
+    let w0sq = p.omega0 * p.omega0;
+    let angle = scene.drive.angle;
+    let viscous = (p.c > 0.0).then_some(Viscous {
+        c: R::from_f64(p.c),
+    });
+    macro_rules! with_extras {
+        ($build:expr) => {
+            match viscous {
+                None => job.run(($build)(NoExtra)),
+                Some(v) => job.run(($build)(v)),
+            }
+        };
+    }
+    match decision.fidelity {
+        Fidelity::Full => with_extras!(|x| FullEom::<R, D, _>::new(w0sq, angle, sig, x)),
+        Fidelity::Averaged => {
+            let r_eff = averaged_r(scene, p);
+            with_extras!(|x| AveragedEom::<R, D, _>::new(w0sq, r_eff, angle, sig, x))
+        }
+        Fidelity::Linearised => {
+            let inverted = fidelity::linearised_centre(scene);
+            let up = angle.cos() < 0.0;
+            with_extras!(|x| LinearisedEom::<R, D, _>::new(w0sq, inverted, up, sig, x))
+        }
+    }
+}
+
+/// The main run as a [`Job`].
+struct Integrate<'c, 'r, Rec: Recorder> {
+    ctx: &'c Context,
+    rec: &'r mut Rec,
+}
+
+impl<'c, 'r, R: Real, Rec: Recorder> Job<R> for Integrate<'c, 'r, Rec> {
+    type Out = Result<RunOut<'r, Rec>, SimError>;
+    fn run<S: System<2, R> + Copy>(self, sys: S) -> Self::Out {
+        integrate(sys, self.ctx, self.rec)
+    }
+}
+
+/// R of the averaged model: R (1 + 4 (a2/a1)²) with a slider-crank (see [`super::eom`]).
+pub(super) fn averaged_r(scene: &Scene, p: &Physical) -> f64 {
+    let ratio = second_harmonic(scene, p) / (p.amplitude / p.ell);
+    p.r * (1.0 + 4.0 * ratio * ratio)
+}
+
+/// Dense output of an accepted DOP853 step as an [`Interpolant`].
+pub(super) struct Dense<'s, 'a, R: Real>(pub &'s Step<'a, 2, R>);
+
+impl<R: Real> Interpolant for Dense<'_, '_, R> {
+    fn at(&mut self, t: f64) -> (f64, f64) {
+        let y = self.0.eval(t);
+        (y[0].to_f64(), y[1].to_f64())
+    }
+}
+
+fn pair<R: Real>(y: &[R; 2]) -> (f64, f64) {
+    (y[0].to_f64(), y[1].to_f64())
+}
+
+/// Integrates a smooth equation with the chosen method, feeding the sampler.
+pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
+    sys: S,
+    ctx: &Context,
+    rec: &'r mut Rec,
+) -> Result<RunOut<'r, Rec>, SimError> {
+    let mut sampler = Sampler::new(
+        ctx.schedule,
+        ctx.strobes_total,
+        ctx.out_dt,
+        ctx.sensor.clone(),
+        ctx.t_end,
+        rec,
+    );
+    sampler.start(ctx.y0.0, ctx.y0.1);
+    let y0 = [R::from_f64(ctx.y0.0), R::from_f64(ctx.y0.1)];
+    let (t, y, work) = match ctx.method {
+        Method::Dop853 { rtol, atol } => {
+            let mut solver = Dop853::new(rtol, atol);
+            // A step may not jump over a whole drive period unseen (long runs of the averaged
+            // model would otherwise step past the strobes' resolution of the slow motion).
+            solver.h_max = 16.0 * ctx.period;
+            solver.max_steps = u64::MAX;
+            let sol = solver.solve(&sys, 0.0, y0, ctx.t_end, |step| {
+                sampler.step(step.t1, pair(&step.y1), &mut Dense(step));
+                StepControl::Continue
+            })?;
+            (sol.t, sol.y, sol.stats)
+        }
+        Method::Rk4 { steps_per_period } => {
+            let n = libm::round(ctx.t_end / ctx.period * steps_per_period).max(1.0) as u64;
+            let h = ctx.t_end / n as f64;
+            let mut prev = (0.0, y0);
+            let mut extra = 0u64;
+            let sol = rk4_observe(&sys, 0.0, y0, h, n, |t, y| {
+                let mut interp = LazyHermite {
+                    sys: &sys,
+                    t0: prev.0,
+                    t1: t,
+                    y0: prev.1,
+                    y1: *y,
+                    ready: None,
+                    evals: &mut extra,
+                };
+                sampler.step(t, pair(y), &mut interp);
+                prev = (t, *y);
+                Control::Continue
+            });
+            let mut work = sol.stats;
+            work.rhs_evals += extra;
+            (sol.t, sol.y, work)
+        }
+    };
+    for v in y {
+        if !v.is_finite() {
+            return Err(SimError::Integrate(IntegrateError::NonFinite { t }));
+        }
+    }
+    let end = (t, y[0].to_f64(), y[1].to_f64());
+    Ok(RunOut {
+        sampler,
+        work,
+        end,
+        sticks: None,
+    })
+}
+
+/// Hermite interpolation whose end derivatives are evaluated only if a sample falls inside the
+/// step (two right-hand-side evaluations, counted as work).
+struct LazyHermite<'s, R: Real, S: System<2, R>> {
+    sys: &'s S,
+    t0: f64,
+    t1: f64,
+    y0: [R; 2],
+    y1: [R; 2],
+    ready: Option<Hermite<R>>,
+    evals: &'s mut u64,
+}
+
+impl<R: Real, S: System<2, R>> Interpolant for LazyHermite<'_, R, S> {
+    fn at(&mut self, t: f64) -> (f64, f64) {
+        if self.ready.is_none() {
+            let (mut f0, mut f1) = ([R::ZERO; 2], [R::ZERO; 2]);
+            self.sys.rhs(self.t0, &self.y0, &mut f0);
+            self.sys.rhs(self.t1, &self.y1, &mut f1);
+            *self.evals += 2;
+            self.ready = Some(Hermite {
+                t0: self.t0,
+                t1: self.t1,
+                y0: self.y0,
+                y1: self.y1,
+                f0,
+                f1,
+            });
+        }
+        self.ready
+            .as_mut()
+            .map_or((f64::NAN, f64::NAN), |h| h.at(t))
+    }
+}

@@ -1,0 +1,314 @@
+//! A scene: one experiment, in SI units and radians, checked once before anything runs.
+//!
+//! The host reads scene files (TOML) into this type; the core never parses text. Every check
+//! names the scene key it concerns, so a loading error can point at the line to fix.
+
+use crate::model::{DriveAngle, Geometry};
+use core::fmt;
+
+/// How the drive frequency is given: ω itself, or R (then ω = ωc √R with the effective gravity).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DriveFrequency {
+    Omega(f64),
+    R(f64),
+}
+
+/// The drive as the scene states it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriveSpec {
+    /// A: half the peak-to-peak stroke (m). With `slider_crank` it is the crank radius.
+    pub amplitude: f64,
+    pub frequency: DriveFrequency,
+    pub angle: DriveAngle,
+}
+
+/// Viscous damping, as a quality factor Q = ω0/c or as γ = c/2 (SPEC §3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Viscous {
+    Q(f64),
+    Gamma(f64),
+}
+
+/// The sensor: what the pivot encoder reports, not what the pendulum does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sensor {
+    /// Resolution: 2^bits counts per turn.
+    pub bits: u32,
+    /// Standard deviation of additive noise (rad).
+    pub noise: f64,
+    /// Samples per second.
+    pub rate_hz: f64,
+}
+
+/// The effects a scene asks for. An absent effect is `None` and costs nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Effects {
+    pub viscous: Option<Viscous>,
+    /// Coulomb friction torque per unit inertia (rad/s²).
+    pub coulomb: Option<f64>,
+    /// Tilt β of the plane of swing (rad): g → g cos β.
+    pub tilt: Option<f64>,
+    /// Slider-crank connecting-rod length b (m): adds the second harmonic (r²/4b) cos 2ϕ.
+    pub slider_crank: Option<f64>,
+    /// Drive ramp duration (s): ω rises linearly from 0 to its set point.
+    pub ramp: Option<f64>,
+    pub sensor: Option<Sensor>,
+    /// Motor speed-loop time constant (s): delivered ω lags the commanded ω (first order).
+    pub actuator: Option<f64>,
+}
+
+/// Which equation to integrate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fidelity {
+    Full,
+    Averaged,
+    Linearised,
+}
+
+/// The fidelity a scene asks for; `Auto` picks the cheapest valid one and says why.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FidelityChoice {
+    Fixed(Fidelity),
+    Auto,
+}
+
+/// How long to run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunLength {
+    /// Drive periods (of the set-point frequency).
+    Periods(f64),
+    /// Seconds.
+    Duration(f64),
+}
+
+/// One experiment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scene {
+    pub pendulum: Geometry,
+    pub drive: DriveSpec,
+    /// g before any tilt (m/s²).
+    pub gravity: f64,
+    /// Initial angle (rad) and rate (rad/s), at t = 0, which is drive phase zero (pivot at +A).
+    pub initial_angle: f64,
+    pub initial_rate: f64,
+    pub length: RunLength,
+    pub fidelity: FidelityChoice,
+    pub effects: Effects,
+}
+
+/// A scene value out of range: the key, the value and what is allowed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneError {
+    pub key: &'static str,
+    pub value: f64,
+    pub allowed: &'static str,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} = {} is out of range: allowed {}",
+            self.key, self.value, self.allowed
+        )
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for SceneError {}
+
+fn check(key: &'static str, value: f64, ok: bool, allowed: &'static str) -> Result<(), SceneError> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(SceneError {
+            key,
+            value,
+            allowed,
+        })
+    }
+}
+
+/// Longest run accepted, in drive periods: 10⁹ keeps every step index exact in f64.
+pub const MAX_PERIODS: f64 = 1e9;
+
+impl Scene {
+    /// Checks every number once; nothing runs on a scene that fails.
+    pub fn check(&self) -> Result<(), SceneError> {
+        let d = &self.drive;
+        check(
+            "drive.amplitude",
+            d.amplitude,
+            d.amplitude > 0.0,
+            "a finite number > 0 (m)",
+        )?;
+        match d.frequency {
+            DriveFrequency::Omega(w) => {
+                check("drive.omega", w, w > 0.0, "a finite number > 0 (rad/s)")?
+            }
+            DriveFrequency::R(r) => check("drive.r", r, r > 0.0, "a finite number > 0")?,
+        }
+        check(
+            "environment.gravity",
+            self.gravity,
+            self.gravity > 0.0,
+            "a finite number > 0 (m/s²)",
+        )?;
+        check(
+            "initial.angle_deg",
+            self.initial_angle,
+            true,
+            "a finite number",
+        )?;
+        check("initial.rate", self.initial_rate, true, "a finite number")?;
+        match self.length {
+            RunLength::Periods(p) => check(
+                "run.periods",
+                p,
+                p > 0.0 && p <= MAX_PERIODS,
+                "a number in (0, 1e9]",
+            )?,
+            RunLength::Duration(s) => check("run.duration", s, s > 0.0, "a finite number > 0 (s)")?,
+        }
+        let e = &self.effects;
+        match e.viscous {
+            Some(Viscous::Q(q)) => check("effects.viscous.q", q, q > 0.0, "a finite number > 0")?,
+            Some(Viscous::Gamma(g)) => check(
+                "effects.viscous.gamma",
+                g,
+                g >= 0.0,
+                "a finite number >= 0 (1/s)",
+            )?,
+            None => {}
+        }
+        if let Some(t) = e.coulomb {
+            check(
+                "effects.coulomb.torque",
+                t,
+                t >= 0.0,
+                "a finite number >= 0 (rad/s²)",
+            )?;
+        }
+        if let Some(b) = e.tilt {
+            let ok = b.abs() < crate::math::FRAC_PI_2;
+            check(
+                "effects.tilt.angle_deg",
+                crate::math::to_deg(b),
+                ok,
+                "a number in (-90, 90) degrees",
+            )?;
+        }
+        if let Some(b) = e.slider_crank {
+            check(
+                "effects.slider_crank.rod_length",
+                b,
+                b > 2.0 * d.amplitude,
+                "a finite number > 2 x drive.amplitude (m)",
+            )?;
+        }
+        if let Some(s) = e.ramp {
+            check(
+                "effects.ramp.seconds",
+                s,
+                s > 0.0,
+                "a finite number > 0 (s)",
+            )?;
+        }
+        if let Some(s) = e.sensor {
+            check(
+                "effects.sensor.bits",
+                f64::from(s.bits),
+                (4..=24).contains(&s.bits),
+                "an integer in [4, 24]",
+            )?;
+            check(
+                "effects.sensor.noise_deg",
+                crate::math::to_deg(s.noise),
+                s.noise >= 0.0,
+                "a finite number >= 0",
+            )?;
+            check(
+                "effects.sensor.rate_hz",
+                s.rate_hz,
+                s.rate_hz > 0.0 && s.rate_hz <= 1e6,
+                "a number in (0, 1e6] (Hz)",
+            )?;
+        }
+        if let Some(t) = e.actuator {
+            check(
+                "effects.actuator.lag_s",
+                t,
+                t > 0.0,
+                "a finite number > 0 (s)",
+            )?;
+        }
+        let p = self.physical()?;
+        check(
+            "drive.amplitude",
+            d.amplitude,
+            d.amplitude < 0.5 * p.ell,
+            "less than half the equivalent length (the model assumes A << l)",
+        )?;
+        Ok(())
+    }
+
+    /// The derived physical constants every model needs.
+    pub fn physical(&self) -> Result<Physical, SceneError> {
+        let ell = self.pendulum.equivalent_length();
+        let g_eff = self.gravity * self.effects.tilt.map_or(1.0, crate::math::cos);
+        let omega0 = crate::math::sqrt(g_eff / ell);
+        let a = self.drive.amplitude;
+        let omega = match self.drive.frequency {
+            DriveFrequency::Omega(w) => w,
+            // R = A²ω²/(2 g ℓ) with the effective gravity (SPEC §5: under tilt R uses g cos β).
+            DriveFrequency::R(r) => crate::math::sqrt(2.0 * g_eff * ell * r) / a,
+        };
+        let c = match self.effects.viscous {
+            None => 0.0,
+            Some(Viscous::Q(q)) => omega0 / q,
+            Some(Viscous::Gamma(g)) => 2.0 * g,
+        };
+        let r = a * a * omega * omega / (2.0 * g_eff * ell);
+        check(
+            "drive.omega",
+            omega,
+            omega > 0.0,
+            "a finite number > 0 (rad/s)",
+        )?;
+        Ok(Physical {
+            ell,
+            g_eff,
+            omega0,
+            omega,
+            r,
+            c,
+            amplitude: a,
+        })
+    }
+
+    /// Run length in seconds.
+    pub fn duration(&self, omega: f64) -> f64 {
+        match self.length {
+            RunLength::Periods(p) => p * crate::math::TAU / omega,
+            RunLength::Duration(s) => s,
+        }
+    }
+}
+
+/// Derived constants of a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Physical {
+    /// Equivalent length ℓ (m).
+    pub ell: f64,
+    /// g cos β (m/s²).
+    pub g_eff: f64,
+    /// √(g_eff/ℓ) (rad/s).
+    pub omega0: f64,
+    /// Set-point drive frequency (rad/s).
+    pub omega: f64,
+    /// R at the set point, with g_eff.
+    pub r: f64,
+    /// Viscous damping coefficient c (1/s); 0 without the effect.
+    pub c: f64,
+    pub amplitude: f64,
+}
