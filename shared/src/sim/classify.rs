@@ -76,9 +76,15 @@ pub enum Outcome {
 /// Why no verdict was given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Undecided {
-    TooShort { strobes: usize },
+    TooShort {
+        strobes: usize,
+    },
     StillSettling,
-    NeitherPeriodicNorChaotic { lyapunov: f64 },
+    NeitherPeriodicNorChaotic {
+        lyapunov: f64,
+    },
+    /// The run was asked not to classify (`Options::classify = false`).
+    NotClassified,
 }
 
 impl core::fmt::Display for Undecided {
@@ -88,6 +94,7 @@ impl core::fmt::Display for Undecided {
                 write!(f, "run too short: {strobes} drive periods, at least {MIN_STROBES} needed")
             }
             Undecided::StillSettling => f.write_str("still settling at the end of the run: run longer"),
+            Undecided::NotClassified => f.write_str("not classified (the run was asked only to integrate)"),
             Undecided::NeitherPeriodicNorChaotic { lyapunov } => write!(
                 f,
                 "neither periodic (to {TOL} rad) nor clearly chaotic (λ = {lyapunov:.3e} 1/s) over the analysis window"

@@ -7,7 +7,7 @@
 //! it does not list. Coulomb friction switches between sliding segments and sticking, so it has
 //! its own loop ([`super::friction`]).
 
-use super::classify::{self, Outcome};
+use super::classify::{self, Outcome, Undecided};
 use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use super::fidelity::{self, Decision, FidelityError};
 use super::friction;
@@ -55,6 +55,10 @@ pub struct Options {
     pub out_dt: f64,
     /// Seed of the sensor's noise.
     pub seed: u64,
+    /// Classify the outcome. Off, a run only integrates and samples (the outcome is
+    /// `Undecided`), which is what benchmarks and error measurements want: classifying can cost
+    /// a second run for the Lyapunov exponent.
+    pub classify: bool,
 }
 
 impl Default for Options {
@@ -64,6 +68,7 @@ impl Default for Options {
             format: Format::F64,
             out_dt: 0.0,
             seed: 1,
+            classify: true,
         }
     }
 }
@@ -140,6 +145,7 @@ pub(super) struct Context {
     pub period: f64,
     pub omega: f64,
     pub undamped: bool,
+    pub classify: bool,
 }
 
 /// The raw result of a generic run, before classification.
@@ -244,6 +250,7 @@ fn run_format<R: Real, Rec: Recorder>(
         period: math::TAU / p.omega,
         omega: p.omega,
         undamped: p.c == 0.0 && scene.effects.coulomb.is_none(),
+        classify: options.classify,
     };
     let a1 = p.amplitude / p.ell;
     if shaped(scene) {
@@ -278,6 +285,22 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
         sticks,
     } = out;
     let mut lyapunov_work = Stats::default();
+    if !ctx.classify {
+        let outcome = Outcome::Undecided {
+            reason: Undecided::NotClassified,
+        };
+        return Ok(Report {
+            outcome,
+            decision,
+            physical: *p,
+            duration: ctx.t_end,
+            strobes: ctx.strobes_total,
+            work,
+            lyapunov_work,
+            end,
+            sticks,
+        });
+    }
     let outcome = classify::classify(&sampler.strobes, p.omega, ctx.undamped, || {
         match (sampler.window_start, scene.effects.coulomb) {
             (Some(start), None) => {
