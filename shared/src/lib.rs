@@ -12,6 +12,7 @@
 //! | [`integrate`] | the `System` trait, work statistics, fixed-step RK4 |
 //! | [`poly`] | small real polynomials: arithmetic and robust real-root isolation |
 //! | [`real`] | the number formats (f64, f32) behind one trait, math through libm |
+//! | [`rig`] | the microcontroller's logic: drive generator, phase lock, fixed-point estimator, safety — tested on the host and on an emulated Cortex-M4 |
 //! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
 //!
 //! # Conventions (SPEC §2–3)
@@ -35,6 +36,7 @@ pub mod math;
 pub mod model;
 pub mod poly;
 pub mod real;
+pub mod rig;
 pub mod stability;
 
 pub use error::ParamError;

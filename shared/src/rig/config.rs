@@ -1,0 +1,242 @@
+//! The rig configuration, defined once: stroke, pendulum, gravity, limits, motor and loop rates.
+//!
+//! It is plain `Copy` data so the firmware can persist it as is and the simulated rig can share
+//! it. Checked once by [`RigConfig::validate`]; everything derived from it for the fixed-point
+//! code comes from [`RigConfig::derived`].
+//!
+//! ```text
+//! R = A²ω²/(2gℓ)  ⇔  ω = ωc √R,  ωc = √(2gℓ)/A        (SPEC §3; model::groups::omega_for_r)
+//! A: amplitude of the pivot's motion, half its peak-to-peak stroke (the crank radius)
+//! ```
+
+use super::fixed::{Angle, RadPerSec};
+use crate::error::{positive, ParamError};
+use crate::model::groups::omega_for_r;
+use crate::model::Geometry;
+
+/// Limits that no command may push the rig past (SPEC §7, "Safety").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Highest drive angular frequency (rad/s).
+    pub omega_max: f64,
+    /// Highest |dω/dt| of the drive reference (rad/s²); also the soft start/stop ramp.
+    pub omega_rate_max: f64,
+    /// Allowed drive angles θd, in degrees, as a closed interval (the actuator mount's travel).
+    pub drive_angle_min_deg: f64,
+    pub drive_angle_max_deg: f64,
+    /// Highest |dθd/dt| (deg/s) of the tilt servo.
+    pub drive_angle_rate_max_deg: f64,
+    /// Motor over-current threshold (A) and how long it may be exceeded (ms) before a stop.
+    pub current_max: f64,
+    pub overcurrent_ms: u32,
+    /// Stall: commanded speed ≥ `stall_min_omega` while the crank turns slower than
+    /// `stall_fraction` of it for `stall_ms`.
+    pub stall_min_omega: f64,
+    pub stall_fraction: f64,
+    pub stall_ms: u32,
+    /// The laptop link is silent after this long without a valid message (ms).
+    pub link_timeout_ms: u32,
+}
+
+/// The crank motor as the phase lock sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotorConfig {
+    /// Steady crank speed at full duty (rad/s): the feed-forward's gain.
+    pub omega_per_duty: f64,
+    /// Speed-loop lag (s): the feed-forward adds τ·dω/dt.
+    pub lag: f64,
+    /// Phase-lock proportional gain (1/s) and integral gain (1/s²) on the phase error.
+    pub kp: f64,
+    pub ki: f64,
+    /// Largest speed correction (rad/s) the phase loop may add to the feed-forward.
+    pub max_correction: f64,
+}
+
+/// The rig: everything the logic needs to know about the hardware, in SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigConfig {
+    /// Drive amplitude A (m): half the peak-to-peak stroke.
+    pub amplitude: f64,
+    pub geometry: Geometry,
+    pub gravity: f64,
+    pub limits: Limits,
+    pub motor: MotorConfig,
+    /// Pendulum sample and DDS tick rate (Hz); control and safety tick rate (Hz). The sample rate
+    /// must be a multiple of the control rate.
+    pub sample_hz: u32,
+    pub control_hz: u32,
+}
+
+/// Fixed-point constants derived from a validated configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Derived {
+    /// ω0² = g/ℓ (1/s²), I16F16.
+    pub omega0_sq: RadPerSec,
+    /// A/ℓ in Q30 (I2F30): the fast wobble's scale.
+    pub a_over_ell: super::fixed::Unit,
+    /// Samples per control tick.
+    pub samples_per_control: u32,
+    /// The DDS rate limit in frequency words per sample tick.
+    pub dds_step: u32,
+    pub theta_d_min: Angle,
+    pub theta_d_max: Angle,
+}
+
+impl RigConfig {
+    /// The reference demo rig: a 25 cm uniform rod on a 10 mm crank (ωc = 180.8 rad/s, so
+    /// R = 3 at ω = 313 rad/s, 50 Hz), a brushed motor reaching 500 rad/s at full duty.
+    pub const REFERENCE: Self = Self {
+        amplitude: 0.010,
+        geometry: Geometry::Rod { length: 0.25 },
+        gravity: 9.81,
+        limits: Limits {
+            omega_max: 420.0,
+            omega_rate_max: 60.0,
+            drive_angle_min_deg: -10.0,
+            drive_angle_max_deg: 190.0,
+            drive_angle_rate_max_deg: 30.0,
+            current_max: 3.0,
+            overcurrent_ms: 20,
+            stall_min_omega: 20.0,
+            stall_fraction: 0.3,
+            stall_ms: 300,
+            link_timeout_ms: 1000,
+        },
+        motor: MotorConfig {
+            omega_per_duty: 500.0,
+            lag: 0.05,
+            kp: 8.0,
+            ki: 16.0,
+            max_correction: 40.0,
+        },
+        sample_hz: 10_000,
+        control_hz: 1_000,
+    };
+
+    /// Checks every number once; the rest of the rig logic relies on it.
+    pub fn validate(self) -> Result<Self, ParamError> {
+        positive("amplitude", self.amplitude)?;
+        positive("gravity", self.gravity)?;
+        positive("equivalent length", self.geometry.equivalent_length())?;
+        let l = &self.limits;
+        positive("omega_max", l.omega_max)?;
+        if l.omega_max >= 30_000.0 {
+            return Err(too_big(
+                "omega_max",
+                l.omega_max,
+                "below 30000 rad/s (I16F16)",
+            ));
+        }
+        positive("omega_rate_max", l.omega_rate_max)?;
+        if super::dds::step_from_rate(l.omega_rate_max, self.sample_hz.max(1)) == 0 {
+            return Err(too_big(
+                "omega_rate_max",
+                l.omega_rate_max,
+                "at least one frequency word per tick, 2*pi*sample_hz/65536 rad/s^2",
+            ));
+        }
+        positive("drive_angle_rate_max_deg", l.drive_angle_rate_max_deg)?;
+        positive("current_max", l.current_max)?;
+        positive("stall_min_omega", l.stall_min_omega)?;
+        positive("stall_fraction", l.stall_fraction)?;
+        if !(l.drive_angle_min_deg.is_finite()
+            && l.drive_angle_max_deg.is_finite()
+            && l.drive_angle_min_deg < l.drive_angle_max_deg
+            && l.drive_angle_max_deg - l.drive_angle_min_deg < 360.0)
+        {
+            return Err(too_big(
+                "drive_angle_max_deg",
+                l.drive_angle_max_deg,
+                "finite, above drive_angle_min_deg, and less than a turn from it",
+            ));
+        }
+        positive("omega_per_duty", self.motor.omega_per_duty)?;
+        positive("lag", self.motor.lag)?;
+        positive("kp", self.motor.kp)?;
+        positive("ki", self.motor.ki)?;
+        positive("max_correction", self.motor.max_correction)?;
+        if self.control_hz == 0
+            || !self.sample_hz.is_multiple_of(self.control_hz)
+            || self.sample_hz > 100_000
+        {
+            return Err(too_big(
+                "sample_hz",
+                f64::from(self.sample_hz),
+                "a multiple of control_hz, at most 100 kHz",
+            ));
+        }
+        Ok(self)
+    }
+
+    /// Equivalent length ℓ (m).
+    pub fn ell(&self) -> f64 {
+        self.geometry.equivalent_length()
+    }
+
+    /// ω that gives drive strength R with this stroke and pendulum: ω = ωc √R.
+    pub fn omega_for_r(&self, r: f64) -> Result<f64, ParamError> {
+        omega_for_r(r, self.ell(), self.gravity, self.amplitude)
+    }
+
+    /// R = A²ω²/(2gℓ) at drive ω.
+    pub fn r_for_omega(&self, omega: f64) -> f64 {
+        self.amplitude * self.amplitude * omega * omega / (2.0 * self.gravity * self.ell())
+    }
+
+    /// ω0 = √(g/ℓ).
+    pub fn omega0(&self) -> f64 {
+        crate::math::sqrt(self.gravity / self.ell())
+    }
+
+    pub fn derived(&self) -> Derived {
+        Derived {
+            omega0_sq: RadPerSec::saturating_from_num(self.gravity / self.ell()),
+            a_over_ell: super::fixed::Unit::saturating_from_num(self.amplitude / self.ell()),
+            samples_per_control: self.sample_hz / self.control_hz.max(1),
+            dds_step: super::dds::step_from_rate(self.limits.omega_rate_max, self.sample_hz),
+            theta_d_min: Angle::from_deg(self.limits.drive_angle_min_deg),
+            theta_d_max: Angle::from_deg(self.limits.drive_angle_max_deg),
+        }
+    }
+}
+
+fn too_big(name: &'static str, value: f64, allowed: &'static str) -> ParamError {
+    ParamError {
+        name,
+        value,
+        allowed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_rig_numbers() {
+        // Closed forms, SPEC §3: ℓ = 2L/3 = 0.1667 m, ωc = √(2gℓ)/A = 180.83 rad/s,
+        // so R = 3 at ω = ωc√3 = 313.2 rad/s; ω0 = √(g/ℓ) = 7.672 rad/s.
+        let c = RigConfig::REFERENCE.validate().unwrap();
+        let w = c.omega_for_r(3.0).unwrap();
+        assert!((w - 180.83 * 3f64.sqrt()).abs() < 0.01, "{w}");
+        assert!((c.r_for_omega(w) - 3.0).abs() < 1e-12);
+        assert!((c.omega0() - 7.672).abs() < 1e-3);
+        let d = c.derived();
+        assert_eq!(d.samples_per_control, 10);
+        assert!((d.omega0_sq.to_num::<f64>() - 58.86).abs() < 1e-4);
+    }
+
+    #[test]
+    fn rejects_bad_configs() {
+        let mut c = RigConfig::REFERENCE;
+        c.amplitude = 0.0;
+        assert_eq!(c.validate().unwrap_err().name, "amplitude");
+        let mut c = RigConfig::REFERENCE;
+        c.sample_hz = 10_001;
+        assert_eq!(c.validate().unwrap_err().name, "sample_hz");
+        let mut c = RigConfig::REFERENCE;
+        c.limits.drive_angle_min_deg = 200.0;
+        assert_eq!(c.validate().unwrap_err().name, "drive_angle_max_deg");
+        assert!(RigConfig::REFERENCE.omega_for_r(-1.0).is_err());
+    }
+}

@@ -1,0 +1,127 @@
+//! One rig: drive generator, phase lock, estimator and safety composed into the two periodic
+//! calls the firmware makes (and the closed-loop tests make in virtual time).
+//!
+//! ```text
+//! sample tick (fs):   φ_ref ← DDS tick;  estimator ← (t, θ_pendulum, φ_ref)
+//! control tick (fc):  motor → (crank angle, current);  safety.check → run / ramp / halt, θd;
+//!                     DDS target or halt (a start aligns the DDS phase to the crank);
+//!                     phase lock → duty → motor;  estimator restarts its slow history while
+//!                     the drive ramps or θd slews
+//! ```
+
+use super::config::RigConfig;
+use super::dds::Dds;
+use super::estimator::{Estimate, Estimator, Tuning};
+use super::fixed::{Angle, Duty, RadPerSec};
+use super::phase_lock::{LockOutput, Motor, PhaseLock};
+use super::safety::{Inputs, Mode, Refusal, Request, Supervisor};
+
+/// What one control tick did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ControlReport {
+    pub mode: Mode,
+    pub duty: Duty,
+    /// Phase error φ_ref − φ_crank (rad).
+    pub phase_error: RadPerSec,
+    pub crank_speed: RadPerSec,
+    pub ref_omega: RadPerSec,
+    /// Slew-limited drive angle for the tilt servo.
+    pub theta_d: Angle,
+    /// The drive is at its set frequency and θd at its target: the estimator is measuring.
+    pub steady: bool,
+}
+
+/// The rig logic.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rig {
+    dds: Dds,
+    lock: PhaseLock,
+    est: Estimator,
+    sup: Supervisor,
+}
+
+impl Rig {
+    /// A stopped rig; `cfg` must have passed [`RigConfig::validate`].
+    pub fn new(cfg: &RigConfig, tuning: &Tuning, theta_d0: Angle, now_us: u32) -> Self {
+        let d = cfg.derived();
+        Self {
+            dds: Dds::new(cfg.sample_hz, d.dds_step),
+            lock: PhaseLock::new(cfg),
+            est: Estimator::new(cfg, tuning, theta_d0),
+            sup: Supervisor::new(cfg, theta_d0, now_us),
+        }
+    }
+
+    /// A valid message arrived from the laptop (keeps the link alive).
+    pub fn link_message(&mut self, now_us: u32) {
+        self.sup.heard_from_link(now_us);
+    }
+
+    /// A command; refused ones change nothing.
+    pub fn request(&mut self, req: Request) -> Result<(), Refusal> {
+        self.sup.request(req)
+    }
+
+    /// Sample tick: advance the reference phase and feed the estimator. Returns the phase.
+    #[inline]
+    pub fn sample(&mut self, t_us: u32, pendulum: Angle) -> Angle {
+        let psi = self.dds.tick();
+        self.est.push(t_us, pendulum, psi);
+        psi
+    }
+
+    /// Control tick.
+    pub fn control<M: Motor>(&mut self, t_us: u32, motor: &mut M, estop: bool) -> ControlReport {
+        let crank = motor.crank_angle();
+        let inputs = Inputs {
+            estop,
+            current: motor.current(),
+            crank_speed: self.lock.crank_speed(),
+            ref_omega: self.dds.omega(),
+            drive_stopped: self.dds.is_stopped(),
+        };
+        let out = self.sup.check(t_us, &inputs);
+        if out.halt {
+            self.dds.halt();
+        } else if out.active && self.dds.is_stopped() && out.target_word > 0 {
+            self.dds.start_at(crank, out.target_word);
+        } else {
+            self.dds.set_target(out.target_word);
+        }
+        let run = out.active && !out.halt;
+        let lock: LockOutput = self.lock.update(
+            run,
+            self.dds.phase(),
+            self.dds.omega(),
+            self.dds.accel(),
+            crank,
+        );
+        motor.set_duty(lock.duty);
+        let steady = run
+            && !self.dds.is_ramping()
+            && self.dds.word() > 0
+            && out.theta_d == self.sup.theta_d_target();
+        if !steady {
+            self.est.reset_slow(out.theta_d);
+        }
+        ControlReport {
+            mode: self.sup.mode(),
+            duty: lock.duty,
+            phase_error: lock.error,
+            crank_speed: lock.crank_speed,
+            ref_omega: self.dds.omega(),
+            theta_d: out.theta_d,
+            steady,
+        }
+    }
+
+    pub fn estimate(&self) -> &Estimate {
+        self.est.estimate()
+    }
+    pub fn dds(&self) -> &Dds {
+        &self.dds
+    }
+    pub fn supervisor(&self) -> &Supervisor {
+        &self.sup
+    }
+}

@@ -1,0 +1,477 @@
+//! The safety supervisor: what the rig may do, and what stops it.
+//!
+//! A state machine with two entry points: [`Supervisor::request`] for commands from the laptop
+//! (checked against the limits; a refused request returns its reason and changes nothing) and
+//! [`Supervisor::check`] once per control tick with the hardware inputs (e-stop line, motor
+//! current, crank speed). Its output says whether the drive may run, the frequency it ramps to,
+//! and the slew-limited drive angle for the tilt servo.
+//!
+//! ```text
+//!            Start(ω ≤ ω_max)                Stop, or link silent > timeout
+//!   Idle ───────────────────────▶ Running ───────────────────────────────▶ Stopping ─▶ Idle
+//!    ▲                               │  SetOmega (ramped), SetDriveAngle (slewed)      (when the
+//!    │ ClearFault (e-stop released)  │                                                  drive is 0)
+//!    └──────────── Faulted ◀─────────┴── e-stop, over-current, stall (from any state): drive
+//!                                        halted at once, duty 0, latched
+//! ```
+//! Limits: ω ≤ ω_max (refused above); |dω/dt| ≤ the ramp rate (the drive generator's step, not
+//! a request); |dθd/dt| ≤ its limit (slewed here); θd inside the mount's travel (refused
+//! outside). Over-current: I > I_max for `overcurrent_ms`. Stall: commanded ω ≥ `stall_min_omega`
+//! and crank speed < `stall_fraction`·commanded for `stall_ms`.
+//!
+//! # When the laptop link goes silent
+//!
+//! The link layer calls [`Supervisor::heard_from_link`] for every valid message. If the rig is
+//! `Running` and nothing valid arrives for `link_timeout_ms`, it performs a *soft stop*: the drive
+//! ramps down at the normal rate limit (an abrupt stop would fling an inverted pendulum), θd holds
+//! where it is, and the mode becomes `Stopping(LinkSilent)` and then `Idle` with the reason kept
+//! in [`Supervisor::last_stop`]. It never restarts by itself: when the link returns the laptop
+//! sees `Idle` and the reason, and must send `Start` again. Silence while `Idle`, `Stopping` or
+//! `Faulted` changes nothing.
+
+use super::config::RigConfig;
+use super::dds::word_from_omega;
+use super::fixed::{elapsed_us, Amps, Angle, RadPerSec};
+
+/// A command from the laptop, in SI units (θd in degrees, as the user gives it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Request {
+    /// Soft start from `Idle` to ω (rad/s).
+    Start { omega: f64 },
+    /// New ω while `Running`; ramped.
+    SetOmega { omega: f64 },
+    /// New drive angle θd (degrees); slewed.
+    SetDriveAngle { deg: f64 },
+    /// Soft stop.
+    Stop,
+    /// Leave `Faulted` once the cause is gone (the e-stop line released).
+    ClearFault,
+}
+
+/// Why a request was refused. The supervisor is unchanged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Refusal {
+    /// Not a finite number ≥ 0.
+    OmegaInvalid {
+        requested: f64,
+    },
+    OmegaAboveLimit {
+        requested: f64,
+        limit: f64,
+    },
+    DriveAngleOutOfRange {
+        requested: f64,
+        min: f64,
+        max: f64,
+    },
+    /// A fault is latched; clear it first.
+    Faulted(Fault),
+    /// `SetOmega` needs `Running`; `Start` needs `Idle`.
+    WrongMode(Mode),
+    /// `ClearFault` while the e-stop line is still active.
+    EStopStillActive,
+}
+
+impl core::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::OmegaInvalid { requested } => {
+                write!(f, "omega = {requested} is not a finite number >= 0")
+            }
+            Self::OmegaAboveLimit { requested, limit } => {
+                write!(
+                    f,
+                    "omega = {requested} rad/s is above the limit {limit} rad/s"
+                )
+            }
+            Self::DriveAngleOutOfRange {
+                requested,
+                min,
+                max,
+            } => write!(
+                f,
+                "drive angle {requested} deg is outside the actuator's travel [{min}, {max}] deg"
+            ),
+            Self::Faulted(x) => write!(f, "a fault is latched ({x:?}): clear it first"),
+            Self::WrongMode(m) => write!(f, "not allowed in mode {m:?}"),
+            Self::EStopStillActive => f.write_str("the emergency stop is still pressed"),
+        }
+    }
+}
+
+/// A latched fault: the drive is halted until [`Request::ClearFault`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    EStop,
+    OverCurrent,
+    Stall,
+}
+
+/// Why the drive last stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    Requested,
+    LinkSilent,
+    Fault(Fault),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Idle,
+    Running,
+    Stopping(StopReason),
+    Faulted(Fault),
+}
+
+/// Hardware inputs for one control tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Inputs {
+    pub estop: bool,
+    pub current: Amps,
+    pub crank_speed: RadPerSec,
+    /// The drive reference ω now (from the drive generator).
+    pub ref_omega: RadPerSec,
+    /// The drive generator has reached zero frequency.
+    pub drive_stopped: bool,
+}
+
+/// What the drive may do after this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Output {
+    /// The phase lock may drive the motor.
+    pub active: bool,
+    /// Stop the drive generator now (no ramp).
+    pub halt: bool,
+    /// Frequency word the drive generator ramps toward.
+    pub target_word: u32,
+    /// Slew-limited drive angle for the tilt servo.
+    pub theta_d: Angle,
+}
+
+/// The supervisor's whole state. `PartialEq` so tests can show a refusal changed nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Supervisor {
+    mode: Mode,
+    last_stop: Option<StopReason>,
+    target_word: u32,
+    theta_target: Angle,
+    theta: Angle,
+    last_link_us: u32,
+    over_since: Option<u32>,
+    stall_since: Option<u32>,
+    estop_seen: bool,
+    // limits, fixed at construction
+    omega_max: f64,
+    theta_min_deg: f64,
+    theta_max_deg: f64,
+    theta_step: u32,
+    current_max: Amps,
+    over_us: u32,
+    stall_min: RadPerSec,
+    stall_frac_q16: i64,
+    stall_us: u32,
+    link_us: u32,
+}
+
+impl Supervisor {
+    /// Idle, with θd at `theta_d0` (the actuator's position at power-up), link heard at `now_us`.
+    pub fn new(cfg: &RigConfig, theta_d0: Angle, now_us: u32) -> Self {
+        let l = &cfg.limits;
+        let per_tick_deg = l.drive_angle_rate_max_deg / f64::from(cfg.control_hz.max(1));
+        Self {
+            mode: Mode::Idle,
+            last_stop: None,
+            target_word: 0,
+            theta_target: theta_d0,
+            theta: theta_d0,
+            last_link_us: now_us,
+            over_since: None,
+            stall_since: None,
+            estop_seen: false,
+            omega_max: l.omega_max,
+            theta_min_deg: l.drive_angle_min_deg,
+            theta_max_deg: l.drive_angle_max_deg,
+            theta_step: libm::floor(per_tick_deg / 360.0 * 4_294_967_296.0).max(1.0) as u32,
+            current_max: Amps::saturating_from_num(l.current_max),
+            over_us: l.overcurrent_ms.saturating_mul(1000),
+            stall_min: RadPerSec::saturating_from_num(l.stall_min_omega),
+            stall_frac_q16: libm::round(l.stall_fraction * 65_536.0) as i64,
+            stall_us: l.stall_ms.saturating_mul(1000),
+            link_us: l.link_timeout_ms.saturating_mul(1000),
+        }
+    }
+
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+    pub fn last_stop(&self) -> Option<StopReason> {
+        self.last_stop
+    }
+    pub fn target_word(&self) -> u32 {
+        self.target_word
+    }
+    pub fn theta_d(&self) -> Angle {
+        self.theta
+    }
+    pub fn theta_d_target(&self) -> Angle {
+        self.theta_target
+    }
+
+    /// A valid message arrived from the laptop.
+    pub fn heard_from_link(&mut self, now_us: u32) {
+        self.last_link_us = now_us;
+    }
+
+    fn check_omega(&self, omega: f64) -> Result<u32, Refusal> {
+        if !omega.is_finite() || omega < 0.0 {
+            return Err(Refusal::OmegaInvalid { requested: omega });
+        }
+        if omega > self.omega_max {
+            return Err(Refusal::OmegaAboveLimit {
+                requested: omega,
+                limit: self.omega_max,
+            });
+        }
+        word_from_omega(omega).ok_or(Refusal::OmegaInvalid { requested: omega })
+    }
+
+    /// Applies a request, or refuses it with the reason and leaves everything as it was.
+    pub fn request(&mut self, req: Request) -> Result<(), Refusal> {
+        if let Mode::Faulted(f) = self.mode {
+            if req != Request::ClearFault {
+                return Err(Refusal::Faulted(f));
+            }
+        }
+        match req {
+            Request::Start { omega } => {
+                let w = self.check_omega(omega)?;
+                if self.mode != Mode::Idle {
+                    return Err(Refusal::WrongMode(self.mode));
+                }
+                self.mode = Mode::Running;
+                self.target_word = w;
+                self.stall_since = None;
+            }
+            Request::SetOmega { omega } => {
+                let w = self.check_omega(omega)?;
+                if self.mode != Mode::Running {
+                    return Err(Refusal::WrongMode(self.mode));
+                }
+                self.target_word = w;
+            }
+            Request::SetDriveAngle { deg } => {
+                if !(deg.is_finite() && deg >= self.theta_min_deg && deg <= self.theta_max_deg) {
+                    return Err(Refusal::DriveAngleOutOfRange {
+                        requested: deg,
+                        min: self.theta_min_deg,
+                        max: self.theta_max_deg,
+                    });
+                }
+                self.theta_target = Angle::from_deg(deg);
+            }
+            Request::Stop => {
+                if self.mode == Mode::Running {
+                    self.mode = Mode::Stopping(StopReason::Requested);
+                    self.target_word = 0;
+                }
+            }
+            Request::ClearFault => {
+                if let Mode::Faulted(_) = self.mode {
+                    if self.estop_seen {
+                        return Err(Refusal::EStopStillActive);
+                    }
+                    self.mode = Mode::Idle;
+                    self.over_since = None;
+                    self.stall_since = None;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn fault(&mut self, f: Fault) {
+        self.mode = Mode::Faulted(f);
+        self.last_stop = Some(StopReason::Fault(f));
+        self.target_word = 0;
+    }
+
+    /// One control tick: faults, link silence, end of a stop, θd slew.
+    pub fn check(&mut self, now_us: u32, inp: &Inputs) -> Output {
+        self.estop_seen = inp.estop;
+        let mut halt = false;
+        if inp.estop {
+            if self.mode != Mode::Faulted(Fault::EStop) {
+                self.fault(Fault::EStop);
+            }
+            halt = true;
+        }
+        // Over-current, debounced by time.
+        if inp.current.saturating_abs() > self.current_max {
+            let since = *self.over_since.get_or_insert(now_us);
+            if elapsed_us(since, now_us) >= self.over_us && !matches!(self.mode, Mode::Faulted(_)) {
+                self.fault(Fault::OverCurrent);
+            }
+        } else {
+            self.over_since = None;
+        }
+        // Stall: driving hard but the crank does not follow.
+        let driving = matches!(self.mode, Mode::Running | Mode::Stopping(_));
+        let want = inp.ref_omega.saturating_abs();
+        let got = inp.crank_speed.saturating_abs();
+        let slow =
+            i64::from(got.to_bits()) * 65_536 < i64::from(want.to_bits()) * self.stall_frac_q16;
+        if driving && want >= self.stall_min && slow {
+            let since = *self.stall_since.get_or_insert(now_us);
+            if elapsed_us(since, now_us) >= self.stall_us {
+                self.fault(Fault::Stall);
+            }
+        } else {
+            self.stall_since = None;
+        }
+        // Link silence: soft stop.
+        if self.mode == Mode::Running && elapsed_us(self.last_link_us, now_us) > self.link_us {
+            self.mode = Mode::Stopping(StopReason::LinkSilent);
+            self.target_word = 0;
+        }
+        if let Mode::Stopping(reason) = self.mode {
+            if inp.drive_stopped {
+                self.mode = Mode::Idle;
+                self.last_stop = Some(reason);
+            }
+        }
+        if let Mode::Faulted(_) = self.mode {
+            halt = true;
+        } else {
+            // Slew θd toward its target by at most one step per tick (shortest way).
+            let d = (self.theta_target - self.theta).to_bits();
+            let step = self.theta_step.min(d.unsigned_abs()) as i32;
+            self.theta += Angle::from_bits(if d >= 0 { step } else { -step });
+        }
+        Output {
+            active: matches!(self.mode, Mode::Running | Mode::Stopping(_)),
+            halt,
+            target_word: self.target_word,
+            theta_d: self.theta,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
+        Inputs {
+            estop: false,
+            current: Amps::ZERO,
+            crank_speed: RadPerSec::from_num(crank),
+            ref_omega: RadPerSec::from_num(ref_omega),
+            drive_stopped: stopped,
+        }
+    }
+
+    #[test]
+    fn refusals_name_the_reason_and_change_nothing() {
+        let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
+        let before = s;
+        assert_eq!(
+            s.request(Request::Start { omega: 500.0 }),
+            Err(Refusal::OmegaAboveLimit {
+                requested: 500.0,
+                limit: 420.0
+            })
+        );
+        assert_eq!(
+            s.request(Request::SetDriveAngle { deg: 200.0 }),
+            Err(Refusal::DriveAngleOutOfRange {
+                requested: 200.0,
+                min: -10.0,
+                max: 190.0
+            })
+        );
+        assert_eq!(
+            s.request(Request::SetOmega { omega: 100.0 }),
+            Err(Refusal::WrongMode(Mode::Idle))
+        );
+        assert!(s.request(Request::Start { omega: f64::NAN }).is_err());
+        assert_eq!(s, before);
+    }
+
+    #[test]
+    fn link_silence_soft_stops_and_never_restarts() {
+        let cfg = RigConfig::REFERENCE;
+        let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+        s.request(Request::Start { omega: 300.0 }).unwrap();
+        let mut t = 0u32;
+        for _ in 0..1000 {
+            t += 1000;
+            s.check(t, &quiet(300.0, 300.0, false));
+        }
+        assert_eq!(s.mode(), Mode::Running); // exactly 1 s of silence is not yet "more than"
+        t += 1000;
+        let out = s.check(t, &quiet(300.0, 300.0, false));
+        assert_eq!(s.mode(), Mode::Stopping(StopReason::LinkSilent));
+        assert!(out.active && !out.halt && out.target_word == 0); // ramp down, not a halt
+        t += 1000;
+        s.check(t, &quiet(0.0, 0.0, true));
+        assert_eq!(s.mode(), Mode::Idle);
+        assert_eq!(s.last_stop(), Some(StopReason::LinkSilent));
+        s.heard_from_link(t);
+        t += 1000;
+        s.check(t, &quiet(0.0, 0.0, true));
+        assert_eq!(s.mode(), Mode::Idle); // no automatic restart
+    }
+
+    #[test]
+    fn estop_halts_at_once_and_latches() {
+        let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
+        s.request(Request::Start { omega: 300.0 }).unwrap();
+        let mut inp = quiet(300.0, 300.0, false);
+        inp.estop = true;
+        let out = s.check(1000, &inp);
+        assert!(out.halt && !out.active);
+        assert_eq!(s.mode(), Mode::Faulted(Fault::EStop));
+        assert_eq!(
+            s.request(Request::ClearFault),
+            Err(Refusal::EStopStillActive)
+        );
+        s.check(2000, &quiet(0.0, 0.0, true));
+        assert_eq!(
+            s.request(Request::Start { omega: 1.0 }),
+            Err(Refusal::Faulted(Fault::EStop))
+        );
+        s.request(Request::ClearFault).unwrap();
+        assert_eq!(s.mode(), Mode::Idle);
+    }
+
+    #[test]
+    fn stall_and_over_current_stop_after_their_debounce() {
+        let cfg = RigConfig::REFERENCE;
+        let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+        s.request(Request::Start { omega: 300.0 }).unwrap();
+        // Crank at 10 % of the reference: stall after 300 ms, not before.
+        let mut t = 0;
+        for _ in 0..300 {
+            t += 1000;
+            s.heard_from_link(t);
+            s.check(t, &quiet(100.0, 10.0, false));
+            assert_eq!(s.mode(), Mode::Running, "t = {t}");
+        }
+        t += 1000;
+        assert!(s.check(t, &quiet(100.0, 10.0, false)).halt);
+        assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
+        s.request(Request::ClearFault).unwrap();
+        s.request(Request::Start { omega: 300.0 }).unwrap();
+        let mut inp = quiet(100.0, 100.0, false);
+        inp.current = Amps::from_num(5);
+        for _ in 0..20 {
+            t += 1000;
+            s.heard_from_link(t);
+            s.check(t, &inp);
+        }
+        assert_eq!(s.mode(), Mode::Running);
+        t += 1000;
+        s.check(t, &inp);
+        assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
+    }
+}
