@@ -1,10 +1,28 @@
 //! Integrators, kept apart from the models through the small [`System`] trait.
 //!
 //! Every integrator reports its work in [`Stats`], so accuracy can be set against cost.
+//!
+//! | integrator | kind | order | cost per step |
+//! |---|---|---|---|
+//! | [`rk4_fixed`], [`rk4_observe`] | classical Runge–Kutta, fixed step | 4 | 4 f-evaluations |
+//! | [`Dop853`] | Dormand–Prince 8(5,3), adaptive, 7th-order dense output | 8 | 12 (+3 when the dense output is used) |
+//! | [`symplectic_fixed`] with [`Symplectic::Verlet`] | Störmer–Verlet (kick–drift–kick) | 2 | 1 force evaluation |
+//! | … with [`Symplectic::Yoshida4`] / [`Symplectic::Yoshida6`] | symmetric compositions of Verlet | 4 / 6 | 3 / 7 |
+//!
+//! Fixed-step drivers call an observer after every step and stop when it returns
+//! [`Control::Stop`]; DOP853 hands the observer the whole accepted [`Step`], whose dense output
+//! can be evaluated anywhere inside it (stroboscopic samples, event location), and the observer
+//! may end the run exactly at a time of its choosing ([`StepControl::StopAt`]).
 
+mod dop853;
+mod fixed;
 mod rk4;
+mod symplectic;
 
-pub use rk4::{rk4_fixed, rk4_step};
+pub use dop853::{Dop853, IntegrateError, Step, StepControl};
+pub use fixed::Control;
+pub use rk4::{rk4_fixed, rk4_observe, rk4_step};
+pub use symplectic::{symplectic_fixed, Force, Phase, Symplectic};
 
 use crate::Real;
 
@@ -36,4 +54,16 @@ impl Stats {
         self.rhs_evals += other.rhs_evals;
         self.rejected += other.rejected;
     }
+}
+
+/// Where a run ended and what it cost. `y` is the state at `t`: `[R; N]` for first-order
+/// systems, [`Phase`] for the symplectic methods.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Solution<Y> {
+    /// The time the run ended: the requested end, or where the observer stopped it.
+    pub t: f64,
+    /// The state at `t`.
+    pub y: Y,
+    /// The work done.
+    pub stats: Stats,
 }

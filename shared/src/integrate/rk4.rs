@@ -1,6 +1,7 @@
 //! The classical fourth-order Runge–Kutta method with a fixed step.
 
-use super::{Stats, System};
+use super::fixed::{self, Control};
+use super::{Solution, Stats, System};
 use crate::Real;
 
 /// One RK4 step of size `h` from (t, y); four right-hand-side evaluations.
@@ -58,6 +59,46 @@ pub fn rk4_fixed<S: System<N, R>, R: Real, const N: usize>(
         y = rk4_step(sys, t, &y, h, stats);
     }
     y
+}
+
+/// Integrates `n` steps of size `h` from (t0, y0), calling `observer(t_i, &y_i)` after every step
+/// (t_i = t0 + i·h, computed afresh); the run ends after step n or when the observer returns
+/// [`Control::Stop`]. Four right-hand-side evaluations per step.
+///
+/// ```
+/// use kapitza_core::integrate::{rk4_observe, Control, System};
+/// struct Decay;
+/// impl System<1> for Decay {
+///     fn rhs(&self, _t: f64, y: &[f64; 1], dy: &mut [f64; 1]) {
+///         dy[0] = -y[0];
+///     }
+/// }
+/// // Stop at the first sample below 1/2: y = e^{−t} crosses it at t = ln 2 ≈ 0.693.
+/// let run = rk4_observe(&Decay, 0.0, [1.0], 0.01, 1000, |_t, y| {
+///     if y[0] < 0.5 { Control::Stop } else { Control::Continue }
+/// });
+/// assert!((run.t - 0.70).abs() < 1e-12);
+/// assert_eq!(run.stats.steps, 70);
+/// assert_eq!(run.stats.rhs_evals, 4 * 70);
+/// ```
+pub fn rk4_observe<S: System<N, R>, R: Real, const N: usize>(
+    sys: &S,
+    t0: f64,
+    y0: [R; N],
+    h: f64,
+    n: u64,
+    observer: impl FnMut(f64, &[R; N]) -> Control,
+) -> Solution<[R; N]> {
+    let mut stats = Stats::default();
+    let (t, y) = fixed::run(
+        t0,
+        h,
+        n,
+        y0,
+        |t, _t_next, y| rk4_step(sys, t, y, h, &mut stats),
+        observer,
+    );
+    Solution { t, y, stats }
 }
 
 #[cfg(test)]
