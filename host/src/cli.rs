@@ -20,6 +20,7 @@ pub struct Cli {
 pub enum Command {
     Predict(cmd::predict::Args),
     Boundary(cmd::boundary::Args),
+    Simulate(cmd::simulate::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -74,6 +75,7 @@ where
     match cli.command {
         Command::Predict(a) => cmd::predict::run(&a, out)?,
         Command::Boundary(a) => cmd::boundary::run(&a, out)?,
+        Command::Simulate(a) => cmd::simulate::run(&a, out)?,
     }
     Ok(())
 }

@@ -1,10 +1,26 @@
 //! The `kapitza` host tool as a library, so end-to-end tests run its commands in-process.
 //!
 //! One module per subcommand under [`cmd`], each holding its `clap` arguments and `run()`.
+//!
+//! | module | concept |
+//! |---|---|
+//! | [`cli`] | parsing, dispatch, and the error type that picks the exit status |
+//! | [`input`] | checks of command-line numbers |
+//! | [`scene_file`] | scene files (TOML) and `--set` → the core's `Scene`, run options, `[expect]` |
+//! | [`outcome`] | the simulator's verdict in user terms, and `[expect]` judged against it |
+//! | [`record`] | what a run keeps for the output files, and its progress bar |
+//! | [`csv_out`] | the samples as CSV |
+//! | [`plot`] | PNG plots with a bundled font |
+//! | [`timing`] | measured cost of a function |
 
 pub mod cli;
 pub mod cmd;
+pub mod csv_out;
 pub mod input;
+pub mod outcome;
+pub mod plot;
+pub mod record;
+pub mod scene_file;
 pub mod timing;
 
 pub use cli::run;

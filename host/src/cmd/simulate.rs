@@ -1,0 +1,395 @@
+//! `kapitza simulate`: run a scene file, say what the pendulum ended up doing and what it cost.
+
+use anyhow::{anyhow, bail, Context, Result};
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::cmd::predict::EquilibriumOut;
+use crate::outcome::{self, Judged, OutcomeOut};
+use crate::record::{self, Collect};
+use crate::scene_file::{self, SceneFile};
+use crate::{csv_out, plot};
+use kapitza_core::math;
+use kapitza_core::model::{equilibria, Stability};
+use kapitza_core::sim::scene::{Fidelity, FidelityChoice};
+use kapitza_core::sim::{simulate, Format, Method, Options, Report, Scene};
+
+/// Simulate a scene file (TOML; keys in docs/scenes.md) and report the outcome: rest (at which
+/// angle), flutter, subharmonic, rotation, chaotic tumbling or oscillation.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// The scene file.
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Override a scene key, e.g. --set drive.angle_deg=120. VALUE is TOML (numbers, true/false,
+    /// "quoted strings", { inline = tables }); a bare word is a string (--set run.fidelity=full);
+    /// an empty VALUE removes the key. Repeatable; may add an effect (--set effects.viscous.q=50).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Write series.csv, strobes.csv, sensed.csv (with a sensor), summary.json, angle.png and
+    /// phase.png into DIR (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print JSON instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Exit with status 1 unless the scene's [expect] table is met (a scene without one fails).
+    #[arg(long)]
+    pub check: bool,
+    /// Time-series samples per drive period for series.csv and the plots (at most 200 000
+    /// samples in all: long runs are sampled more sparsely).
+    #[arg(long, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+    pub samples_per_period: u32,
+}
+
+/// The `--json` output, also written to `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    /// The scene file as given.
+    pub scene: String,
+    pub title: String,
+    pub outcome: OutcomeOut,
+    /// The scene's `[expect]` with `met`; `null` when the scene has none.
+    pub expect: Option<Judged>,
+    pub fidelity: FidelityOut,
+    /// `"dop853"` or `"rk4"`.
+    pub method: &'static str,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub steps_per_period: Option<f64>,
+    /// `"f64"` or `"f32"`.
+    pub format: &'static str,
+    /// R = A²ω²/(2 g_eff ℓ) at the set point.
+    pub r: f64,
+    /// R of the averaged theory: R (1 + A²/(4b²)) with a slider-crank of rod length b, else R.
+    /// The predicted equilibria use it.
+    pub r_effective: f64,
+    /// Set-point drive frequency (rad/s).
+    pub omega: f64,
+    /// √(g_eff/ℓ) (rad/s).
+    pub omega0: f64,
+    pub drive_angle_deg: f64,
+    /// A (m).
+    pub amplitude: f64,
+    /// ℓ (m).
+    pub equivalent_length: f64,
+    /// g cos β (m/s²).
+    pub gravity_effective: f64,
+    /// Viscous c = 2γ (1/s); 0 without the effect.
+    pub damping_c: f64,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Drive periods completed (stroboscopic samples).
+    pub periods: u64,
+    pub wall_s: f64,
+    /// Simulated seconds per wall-clock second.
+    pub real_time_factor: f64,
+    pub work: WorkOut,
+    pub end: EndOut,
+    /// With Coulomb friction: how many times the pendulum stuck; else `null`.
+    pub sticks: Option<u64>,
+    /// Equilibria of the averaged theory at `r_effective` and θd, as `kapitza predict` lists them.
+    pub predicted: Vec<EquilibriumOut>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct FidelityOut {
+    /// What the scene asked for: `"auto"`, `"full"`, `"averaged"` or `"linearised"`.
+    pub requested: &'static str,
+    /// What ran.
+    pub used: &'static str,
+    pub reason: String,
+}
+
+#[derive(Debug, Serialize)]
+pub struct WorkOut {
+    pub steps: u64,
+    pub rhs_evals: u64,
+    pub rejected: u64,
+    pub lyapunov_steps: u64,
+    pub lyapunov_rhs_evals: u64,
+    pub lyapunov_rejected: u64,
+}
+
+#[derive(Debug, Serialize)]
+pub struct EndOut {
+    pub t: f64,
+    /// In (−180°, 180°].
+    pub angle_deg: f64,
+    /// Turns completed, from the unwrapped angle (rounded towards zero).
+    pub turns: i64,
+    pub rate: f64,
+}
+
+/// The averaged model's R: a slider-crank's second harmonic (A²/4b) cos 2ϕ adds
+/// R·4(a2/a1)² = R·A²/(4b²) (kapitza_core::sim::eom, the same formula as its `averaged_r`).
+fn averaged_r(scene: &Scene, r: f64) -> f64 {
+    scene.effects.slider_crank.map_or(r, |b| {
+        let ratio = scene.drive.amplitude / (4.0 * b);
+        r * (1.0 + 4.0 * ratio * ratio)
+    })
+}
+
+fn fidelity_name(f: Fidelity) -> &'static str {
+    match f {
+        Fidelity::Full => "full",
+        Fidelity::Averaged => "averaged",
+        Fidelity::Linearised => "linearised",
+    }
+}
+
+pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    let file = scene_file::load(&args.scene, &args.set)?;
+    let name = args.scene.display().to_string();
+    let p = file.scene.physical().map_err(|e| anyhow!("{name}: {e}"))?;
+    let duration = file.scene.duration(p.omega);
+    let out_dt = if args.out.is_some() {
+        record::output_interval(math::TAU / p.omega, args.samples_per_period, duration)
+    } else {
+        0.0
+    };
+    let options = Options {
+        method: file.method,
+        format: file.format,
+        out_dt,
+        seed: file.seed,
+        ..Options::default()
+    };
+    let mut rec = Collect::new(args.out.is_some());
+    let start = Instant::now();
+    let result = simulate(&file.scene, &options, &mut rec);
+    let wall = start.elapsed().as_secs_f64();
+    rec.finish();
+    let report = result.map_err(|e| anyhow!("{name}: {e}"))?;
+    let summary = summarise(&name, &file, &report, wall)?;
+    let mut written = Vec::new();
+    if let Some(dir) = &args.out {
+        written = write_out(dir, &file, &summary, &rec)?;
+    }
+    if args.json {
+        serde_json::to_writer_pretty(&mut *out, &summary)?;
+        writeln!(out)?;
+    } else {
+        print_summary(&summary, &report, out)?;
+        for f in &written {
+            writeln!(out, "wrote {}", f.display())?;
+        }
+    }
+    if args.check {
+        match &summary.expect {
+            None => bail!("{name}: --check needs an [expect] table, and the scene has none"),
+            Some(j) if !j.met => bail!(
+                "{name}: expectation not met: {}",
+                j.why_not.as_deref().unwrap_or("")
+            ),
+            Some(_) => {}
+        }
+    }
+    Ok(())
+}
+
+fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result<Summary> {
+    let p = &report.physical;
+    let scene = &file.scene;
+    let outcome = OutcomeOut::from(report.outcome);
+    let r_effective = averaged_r(scene, p.r);
+    let eqs = equilibria(r_effective, scene.drive.angle).context("predicted equilibria")?;
+    let predicted = eqs
+        .as_slice()
+        .map(|e| EquilibriumOut {
+            angle_deg: outcome::deg(e.angle),
+            stability: match e.stability {
+                Stability::Stable => "stable",
+                Stability::Unstable => "unstable",
+                Stability::Marginal => "marginal",
+            },
+            stable: e.stability == Stability::Stable,
+            marginal: e.stability == Stability::Marginal,
+            margin: e.margin,
+            omega_p_over_omega0: e.omega_p_over_omega0,
+            omega_p: e.omega_p_over_omega0.map(|x| x * p.omega0),
+            within_90_of_drive: e.within_90_of_drive,
+        })
+        .collect();
+    let (method, rtol, atol, steps_per_period) = match file.method {
+        Method::Dop853 { rtol, atol } => ("dop853", Some(rtol), Some(atol), None),
+        Method::Rk4 { steps_per_period } => ("rk4", None, None, Some(steps_per_period)),
+    };
+    let (t_end, theta_end, rate_end) = report.end;
+    Ok(Summary {
+        scene: name.to_string(),
+        title: file.title.clone(),
+        expect: file.expect.as_ref().map(|e| e.judge(&outcome)),
+        outcome,
+        fidelity: FidelityOut {
+            requested: match scene.fidelity {
+                FidelityChoice::Auto => "auto",
+                FidelityChoice::Fixed(f) => fidelity_name(f),
+            },
+            used: fidelity_name(report.decision.fidelity),
+            reason: report.decision.to_string(),
+        },
+        method,
+        rtol,
+        atol,
+        steps_per_period,
+        format: match file.format {
+            Format::F64 => "f64",
+            Format::F32 => "f32",
+        },
+        r: p.r,
+        r_effective,
+        omega: p.omega,
+        omega0: p.omega0,
+        drive_angle_deg: scene.drive.angle.deg(),
+        amplitude: p.amplitude,
+        equivalent_length: p.ell,
+        gravity_effective: p.g_eff,
+        damping_c: p.c,
+        duration_s: report.duration,
+        periods: report.strobes,
+        wall_s: wall,
+        real_time_factor: report.duration / wall.max(1e-9),
+        work: WorkOut {
+            steps: report.work.steps,
+            rhs_evals: report.work.rhs_evals,
+            rejected: report.work.rejected,
+            lyapunov_steps: report.lyapunov_work.steps,
+            lyapunov_rhs_evals: report.lyapunov_work.rhs_evals,
+            lyapunov_rejected: report.lyapunov_work.rejected,
+        },
+        end: EndOut {
+            t: t_end,
+            angle_deg: outcome::deg(theta_end),
+            turns: (theta_end / math::TAU).trunc() as i64,
+            rate: rate_end,
+        },
+        sticks: report.sticks,
+        predicted,
+    })
+}
+
+fn print_summary(s: &Summary, report: &Report, out: &mut dyn Write) -> Result<()> {
+    writeln!(out, "{}  ({})", s.title, s.scene)?;
+    writeln!(
+        out,
+        "drive: R = {:.4}, ω = {:.2} rad/s, θd = {}°, A = {} m; ℓ = {:.4} m, ω0 = {:.3} rad/s (ω/ω0 = {:.1})",
+        s.r,
+        s.omega,
+        s.drive_angle_deg,
+        s.amplitude,
+        s.equivalent_length,
+        s.omega0,
+        s.omega / s.omega0
+    )?;
+    writeln!(
+        out,
+        "fidelity: {} ({} requested): {}",
+        s.fidelity.used, s.fidelity.requested, s.fidelity.reason
+    )?;
+    let method = match (s.rtol, s.atol, s.steps_per_period) {
+        (Some(r), Some(a), _) => format!("DOP853, rtol {r:e}, atol {a:e}"),
+        (_, _, Some(n)) => format!("RK4, {n} steps per drive period"),
+        _ => s.method.to_string(),
+    };
+    writeln!(out, "method: {method}; numbers: {}", s.format)?;
+    writeln!(out, "outcome: {}", s.outcome)?;
+    if let Some(j) = &s.expect {
+        if j.met {
+            writeln!(out, "expected: {} — met", j.expect)?;
+        } else {
+            writeln!(
+                out,
+                "expected: {} — NOT MET: {}",
+                j.expect,
+                j.why_not.as_deref().unwrap_or("")
+            )?;
+        }
+    }
+    let eqs: Vec<String> = s
+        .predicted
+        .iter()
+        .map(|e| {
+            let reach = if e.within_90_of_drive {
+                ""
+            } else {
+                ", beyond 90° of the drive"
+            };
+            format!("{} {}{reach}", outcome::show_deg(e.angle_deg), e.stability)
+        })
+        .collect();
+    writeln!(
+        out,
+        "predicted equilibria (averaged theory): {}",
+        eqs.join("; ")
+    )?;
+    if let Some(n) = s.sticks {
+        writeln!(out, "stick–slip: stuck {n} times")?;
+    }
+    let w = &s.work;
+    write!(
+        out,
+        "work: {} steps, {} rhs evaluations, {} rejected",
+        w.steps, w.rhs_evals, w.rejected
+    )?;
+    if report.lyapunov_work.rhs_evals > 0 {
+        write!(
+            out,
+            "; Lyapunov run {} rhs evaluations",
+            w.lyapunov_rhs_evals
+        )?;
+    }
+    writeln!(out)?;
+    writeln!(
+        out,
+        "time: {} drive periods = {:.3} s simulated in {:.3} s wall (real-time factor {:.3e})",
+        s.periods, s.duration_s, s.wall_s, s.real_time_factor
+    )?;
+    Ok(())
+}
+
+/// Writes the CSV files, `summary.json` and the plots; returns the paths written.
+fn write_out(dir: &Path, file: &SceneFile, s: &Summary, rec: &Collect) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut written = Vec::new();
+    let mut path = |name: &str| {
+        let p = dir.join(name);
+        written.push(p.clone());
+        p
+    };
+    csv_out::series(&path("series.csv"), &rec.series)?;
+    csv_out::strobes(&path("strobes.csv"), &rec.strobes)?;
+    if file.scene.effects.sensor.is_some() {
+        csv_out::sensed(&path("sensed.csv"), &rec.sensed)?;
+    }
+    let json = path("summary.json");
+    let mut text = serde_json::to_string_pretty(s)?;
+    text.push('\n');
+    std::fs::write(&json, text).with_context(|| format!("cannot write {}", json.display()))?;
+    let centre = s
+        .outcome
+        .angle_deg()
+        .unwrap_or_else(|| outcome::deg(rec.series.last().map_or(0.0, |x| x[1])));
+    let input = plot::PlotInput {
+        title: &s.title,
+        subtitle: format!(
+            "R = {:.3}, θd = {}°, ω = {:.1} rad/s, {} model, {}  —  outcome: {}",
+            s.r, s.drive_angle_deg, s.omega, s.fidelity.used, s.method, s.outcome
+        ),
+        series: &rec.series,
+        strobes: rec.strobes.iter().map(|r| (r.theta, r.rate)).collect(),
+        equilibria: equilibria(s.r_effective, file.scene.drive.angle)
+            .context("predicted equilibria")?
+            .as_slice()
+            .map(|e| (outcome::deg(e.angle), e.stability))
+            .collect(),
+        window_lo: plot::window_lo(centre),
+        t_end: s.duration_s,
+        averaged: s.fidelity.used == "averaged",
+    };
+    plot::angle_png(&path("angle.png"), &input)?;
+    plot::phase_png(&path("phase.png"), &input)?;
+    Ok(written)
+}

@@ -1,0 +1,623 @@
+//! Scene files: TOML text → the core's [`Scene`], the run options and the `[expect]` table.
+//!
+//! Reading goes in three steps, each with errors that name the file and the key:
+//! 1. the text parses as TOML into a table (syntax errors carry the line);
+//! 2. `--set KEY=VALUE` overrides are written into that table at their dotted paths;
+//! 3. the table deserialises into raw structs (`deny_unknown_fields` everywhere, so a misspelt key
+//!    or an unknown effect is an error listing the allowed ones), which are converted to SI units
+//!    and radians and checked: by hand where two keys interact, by [`Scene::check`] for ranges,
+//!    and by the fidelity decision, so that nothing runs on a bad scene.
+//!
+//! The keys, their units, defaults and ranges are documented in `docs/scenes.md`.
+
+use anyhow::{anyhow, bail, Context, Result};
+use serde::Deserialize;
+use std::path::Path;
+
+use crate::outcome::{Expect, ExpectKind};
+use kapitza_core::math;
+use kapitza_core::model::{DriveAngle, Geometry};
+use kapitza_core::sim::scene::{
+    DriveFrequency, DriveSpec, Effects, Fidelity, FidelityChoice, RunLength, Sensor, Viscous,
+};
+use kapitza_core::sim::{fidelity, Format, Method, Scene};
+use kapitza_core::ParamError;
+
+/// RK4 steps per drive period when `run.steps_per_period` is not given.
+pub const DEFAULT_RK4_STEPS: f64 = 200.0;
+
+/// A loaded, checked scene file.
+#[derive(Debug, Clone)]
+pub struct SceneFile {
+    /// `title`, or the file's stem when the file has none.
+    pub title: String,
+    pub scene: Scene,
+    pub method: Method,
+    pub format: Format,
+    /// Seed of the sensor noise.
+    pub seed: u64,
+    pub expect: Option<Expect>,
+}
+
+/// Reads, overrides (`sets`: `KEY=VALUE` strings) and checks a scene file.
+pub fn load(path: &Path, sets: &[String]) -> Result<SceneFile> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).with_context(|| format!("{name}: cannot read"))?;
+    let stem = path
+        .file_stem()
+        .map_or_else(|| name.clone(), |s| s.to_string_lossy().into_owned());
+    parse(&text, &name, &stem, sets)
+}
+
+/// [`load`] on text already read: `name` prefixes every error, `stem` is the default title.
+pub fn parse(text: &str, name: &str, stem: &str, sets: &[String]) -> Result<SceneFile> {
+    let mut table: toml::Table = toml::from_str(text)
+        .map_err(|e| anyhow!("{}", e.to_string().trim_end()))
+        .with_context(|| format!("{name}: not valid TOML"))?;
+    let mut set_keys = Vec::new();
+    for s in sets {
+        set_keys.push(apply_set(&mut table, s).with_context(|| name.to_string())?);
+    }
+    let raw: RawScene =
+        serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+            let path = e.path().to_string();
+            let origin = set_keys
+                .iter()
+                .find(|(k, _)| within(&path, k) || within(k, &path))
+                .map_or(String::new(), |(_, s)| format!(" (from --set {s})"));
+            let at = if path == "." {
+                String::new()
+            } else {
+                format!("{path}: ")
+            };
+            anyhow!("{name}: {at}{}{origin}", e.inner().message().trim_end())
+        })?;
+    convert(raw, stem).with_context(|| name.to_string())
+}
+
+/// Whether the dotted path `inner` is `outer` or lies under it.
+fn within(inner: &str, outer: &str) -> bool {
+    inner
+        .strip_prefix(outer)
+        .is_some_and(|rest| rest.is_empty() || rest.starts_with('.'))
+}
+
+/// Writes one `--set KEY=VALUE` into the table; returns the key and the assignment.
+///
+/// VALUE is a TOML value (`120`, `1e-3`, `true`, `"quoted string"`, `{ q = 50 }`); a bare word
+/// that is not a TOML value (`full`, `dop853`) is taken as a string; an empty VALUE removes the
+/// key (if it is there).
+pub fn apply_set(table: &mut toml::Table, assignment: &str) -> Result<(String, String)> {
+    let Some((key, text)) = assignment.split_once('=') else {
+        bail!("--set {assignment}: expected KEY=VALUE, e.g. --set drive.angle_deg=120");
+    };
+    let (key, text) = (key.trim(), text.trim());
+    let parts: Vec<&str> = key.split('.').collect();
+    let bare = |s: &str| {
+        !s.is_empty()
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    };
+    if !parts.iter().all(|p| bare(p)) {
+        bail!("--set {assignment}: key `{key}` is not a dotted path of bare keys (like effects.viscous.q)");
+    }
+    let (last, path) = parts.split_last().expect("split yields at least one part");
+    if text.is_empty() {
+        // KEY= removes the key, e.g. to give omega in a scene that gives r.
+        let mut here = Some(&mut *table);
+        for part in path {
+            here = here
+                .and_then(|t| t.get_mut(*part))
+                .and_then(|v| v.as_table_mut());
+        }
+        if let Some(t) = here {
+            t.remove(*last);
+        }
+        return Ok((key.to_string(), assignment.to_string()));
+    }
+    let value = match toml::from_str::<toml::Table>(&format!("v = {text}")) {
+        Ok(mut t) if t.len() == 1 => t.remove("v").expect("the one key is v"),
+        _ if bare(text) => toml::Value::String(text.to_string()),
+        _ => bail!(
+            "--set {assignment}: `{text}` is not a TOML value (numbers, true/false, \"quoted strings\", {{ inline = tables }}; a bare word is a string)"
+        ),
+    };
+    let mut here = table;
+    for (i, part) in path.iter().enumerate() {
+        let entry = here
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        here = match entry {
+            toml::Value::Table(t) => t,
+            other => bail!(
+                "--set {assignment}: `{}` is a {}, not a table, so it has no key `{}`",
+                parts[..=i].join("."),
+                other.type_str(),
+                parts[i + 1]
+            ),
+        };
+    }
+    here.insert(last.to_string(), value);
+    Ok((key.to_string(), assignment.to_string()))
+}
+
+// ---------------------------------------------------------------------------------------------
+// The file as written.
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a scene table")]
+struct RawScene {
+    title: Option<String>,
+    pendulum: RawPendulum,
+    drive: RawDrive,
+    #[serde(default)]
+    environment: RawEnvironment,
+    #[serde(default)]
+    initial: RawInitial,
+    run: RawRun,
+    #[serde(default)]
+    effects: RawEffects,
+    expect: Option<RawExpect>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum GeometryName {
+    Rod,
+    Point,
+    General,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [pendulum]")]
+struct RawPendulum {
+    geometry: GeometryName,
+    length: Option<f64>,
+    inertia: Option<f64>,
+    mass: Option<f64>,
+    com: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [drive]")]
+struct RawDrive {
+    amplitude: f64,
+    omega: Option<f64>,
+    r: Option<f64>,
+    angle_deg: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [environment]")]
+struct RawEnvironment {
+    #[serde(default = "standard_gravity")]
+    gravity: f64,
+}
+
+fn standard_gravity() -> f64 {
+    9.81
+}
+
+impl Default for RawEnvironment {
+    fn default() -> Self {
+        Self {
+            gravity: standard_gravity(),
+        }
+    }
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [initial]")]
+struct RawInitial {
+    #[serde(default)]
+    angle_deg: f64,
+    #[serde(default)]
+    rate: f64,
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum FidelityName {
+    Full,
+    Averaged,
+    Linearised,
+    #[default]
+    Auto,
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum MethodName {
+    #[default]
+    Auto,
+    Dop853,
+    Rk4,
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum FormatName {
+    #[default]
+    F64,
+    F32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [run]")]
+struct RawRun {
+    periods: Option<f64>,
+    duration: Option<f64>,
+    #[serde(default)]
+    fidelity: FidelityName,
+    #[serde(default)]
+    method: MethodName,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    steps_per_period: Option<f64>,
+    #[serde(default)]
+    format: FormatName,
+    seed: Option<u64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table of effects")]
+struct RawEffects {
+    viscous: Option<RawViscous>,
+    coulomb: Option<RawCoulomb>,
+    tilt: Option<RawTilt>,
+    slider_crank: Option<RawSliderCrank>,
+    ramp: Option<RawRamp>,
+    sensor: Option<RawSensor>,
+    actuator: Option<RawActuator>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table: viscous = { q = … } or { gamma = … }"
+)]
+struct RawViscous {
+    q: Option<f64>,
+    gamma: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: coulomb = { torque = … }")]
+struct RawCoulomb {
+    torque: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: tilt = { angle_deg = … }")]
+struct RawTilt {
+    angle_deg: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table: slider_crank = { rod_length = … }"
+)]
+struct RawSliderCrank {
+    rod_length: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: ramp = { seconds = … }")]
+struct RawRamp {
+    seconds: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table: sensor = { bits = …, noise_deg = …, rate_hz = … }"
+)]
+struct RawSensor {
+    bits: u32,
+    #[serde(default)]
+    noise_deg: f64,
+    rate_hz: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: actuator = { lag_s = … }")]
+struct RawActuator {
+    lag_s: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [expect]")]
+struct RawExpect {
+    kind: ExpectKind,
+    angle_deg: Option<f64>,
+    tolerance_deg: Option<f64>,
+    order: Option<u32>,
+    direction: Option<i64>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Conversion and checks.
+
+/// `key = value` is out of range.
+fn out_of_range(key: &str, value: impl std::fmt::Display, allowed: &str) -> anyhow::Error {
+    anyhow!("{key} = {value} is out of range: allowed {allowed}")
+}
+
+fn finite(key: &str, v: f64) -> Result<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(out_of_range(key, v, "a finite number"))
+    }
+}
+
+fn non_negative(key: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(out_of_range(key, v, "a finite number >= 0"))
+    }
+}
+
+/// A core constructor's [`ParamError`] in terms of the scene key it came from.
+fn param(key: &str, e: ParamError) -> anyhow::Error {
+    out_of_range(key, e.value, e.allowed)
+}
+
+fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
+    let pendulum = pendulum(&raw.pendulum)?;
+    let d = &raw.drive;
+    let frequency = match (d.omega, d.r) {
+        (Some(w), None) => DriveFrequency::Omega(w),
+        (None, Some(r)) => DriveFrequency::R(r),
+        (Some(w), Some(r)) => bail!(
+            "drive: both omega = {w} and r = {r} are given: allowed exactly one (omega in rad/s, or r, from which ω follows)"
+        ),
+        (None, None) => {
+            bail!("drive: neither omega nor r is given: allowed exactly one (omega in rad/s, or r, from which ω follows)")
+        }
+    };
+    let angle = DriveAngle::from_deg(d.angle_deg).map_err(|e| param("drive.angle_deg", e))?;
+    let drive = DriveSpec {
+        amplitude: d.amplitude,
+        frequency,
+        angle,
+    };
+    let run = &raw.run;
+    let length = match (run.periods, run.duration) {
+        (Some(p), None) => RunLength::Periods(p),
+        (None, Some(s)) => RunLength::Duration(s),
+        (Some(p), Some(s)) => bail!(
+            "run: both periods = {p} and duration = {s} are given: allowed exactly one (periods: drive periods, or duration in s)"
+        ),
+        (None, None) => bail!(
+            "run: neither periods nor duration is given: allowed exactly one (periods: drive periods, or duration in s)"
+        ),
+    };
+    let fidelity = match run.fidelity {
+        FidelityName::Full => FidelityChoice::Fixed(Fidelity::Full),
+        FidelityName::Averaged => FidelityChoice::Fixed(Fidelity::Averaged),
+        FidelityName::Linearised => FidelityChoice::Fixed(Fidelity::Linearised),
+        FidelityName::Auto => FidelityChoice::Auto,
+    };
+    let effects = effects(&raw.effects)?;
+    let scene = Scene {
+        pendulum,
+        drive,
+        gravity: raw.environment.gravity,
+        initial_angle: math::to_rad(finite("initial.angle_deg", raw.initial.angle_deg)?),
+        initial_rate: finite("initial.rate", raw.initial.rate)?,
+        length,
+        fidelity,
+        effects,
+    };
+    scene.check().map_err(|e| anyhow!("{e}"))?;
+    let p = scene.physical().map_err(|e| anyhow!("{e}"))?;
+    fidelity::decide(&scene, &p).map_err(|e| anyhow!("{e}"))?;
+    let method = method(run)?;
+    if matches!(method, Method::Rk4 { .. }) && scene.effects.coulomb.is_some() {
+        bail!("run.method = \"rk4\" cannot run effects.coulomb: allowed \"dop853\" or \"auto\" (stick–slip needs event location)");
+    }
+    Ok(SceneFile {
+        title: raw.title.unwrap_or_else(|| stem.to_string()),
+        scene,
+        method,
+        format: match run.format {
+            FormatName::F64 => Format::F64,
+            FormatName::F32 => Format::F32,
+        },
+        seed: run.seed.unwrap_or(1),
+        expect: raw.expect.map(expect).transpose()?,
+    })
+}
+
+fn pendulum(p: &RawPendulum) -> Result<Geometry> {
+    let name = match p.geometry {
+        GeometryName::Rod => "rod",
+        GeometryName::Point => "point",
+        GeometryName::General => "general",
+    };
+    match p.geometry {
+        GeometryName::Rod | GeometryName::Point => {
+            for (key, v) in [("inertia", p.inertia), ("mass", p.mass), ("com", p.com)] {
+                if let Some(v) = v {
+                    bail!("pendulum.{key} = {v} is not allowed with geometry = \"{name}\": allowed only length (m)");
+                }
+            }
+            let Some(length) = p.length else {
+                bail!("pendulum: missing field `length` (m), needed by geometry = \"{name}\"");
+            };
+            let g = match p.geometry {
+                GeometryName::Rod => Geometry::rod(length),
+                _ => Geometry::point_mass(length),
+            };
+            g.map_err(|e| param("pendulum.length", e))
+        }
+        GeometryName::General => {
+            if let Some(v) = p.length {
+                bail!("pendulum.length = {v} is not allowed with geometry = \"general\": allowed inertia (kg m²), mass (kg) and com (m)");
+            }
+            let need = |key: &str, v: Option<f64>| {
+                v.ok_or_else(|| {
+                    anyhow!("pendulum: missing field `{key}`, needed by geometry = \"general\" (inertia in kg m², mass in kg, com in m)")
+                })
+            };
+            let (i, m, z) = (
+                need("inertia", p.inertia)?,
+                need("mass", p.mass)?,
+                need("com", p.com)?,
+            );
+            Geometry::general(i, m, z).map_err(|e| param(&format!("pendulum.{}", e.name), e))
+        }
+    }
+}
+
+fn effects(e: &RawEffects) -> Result<Effects> {
+    let viscous = match &e.viscous {
+        None => None,
+        Some(RawViscous {
+            q: Some(q),
+            gamma: None,
+        }) => Some(Viscous::Q(*q)),
+        Some(RawViscous {
+            q: None,
+            gamma: Some(g),
+        }) => Some(Viscous::Gamma(*g)),
+        Some(RawViscous {
+            q: Some(q),
+            gamma: Some(g),
+        }) => bail!(
+            "effects.viscous: both q = {q} and gamma = {g} are given: allowed exactly one (q = ω0/(2γ), or gamma in 1/s)"
+        ),
+        Some(RawViscous {
+            q: None,
+            gamma: None,
+        }) => bail!("effects.viscous: neither q nor gamma is given: allowed exactly one (q = ω0/(2γ), or gamma in 1/s)"),
+    };
+    let sensor = match &e.sensor {
+        None => None,
+        Some(s) => Some(Sensor {
+            bits: s.bits,
+            noise: math::to_rad(non_negative("effects.sensor.noise_deg", s.noise_deg)?),
+            rate_hz: s.rate_hz,
+        }),
+    };
+    let tilt = match &e.tilt {
+        None => None,
+        // Checked here in degrees, so the message repeats the value as written.
+        Some(t) if t.angle_deg.is_finite() && t.angle_deg.abs() < 90.0 => {
+            Some(math::to_rad(t.angle_deg))
+        }
+        Some(t) => {
+            return Err(out_of_range(
+                "effects.tilt.angle_deg",
+                t.angle_deg,
+                "a number in (-90, 90) degrees",
+            ))
+        }
+    };
+    Ok(Effects {
+        viscous,
+        coulomb: e.coulomb.as_ref().map(|c| c.torque),
+        tilt,
+        slider_crank: e.slider_crank.as_ref().map(|s| s.rod_length),
+        ramp: e.ramp.as_ref().map(|r| r.seconds),
+        sensor,
+        actuator: e.actuator.as_ref().map(|a| a.lag_s),
+    })
+}
+
+fn method(run: &RawRun) -> Result<Method> {
+    let positive = |key: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(out_of_range(key, v, "a finite number > 0"))
+        }
+    };
+    match run.method {
+        MethodName::Rk4 => {
+            for (key, v) in [("rtol", run.rtol), ("atol", run.atol)] {
+                if let Some(v) = v {
+                    bail!("run.{key} = {v} is not allowed with method = \"rk4\": allowed steps_per_period (rtol and atol are for \"dop853\")");
+                }
+            }
+            let steps_per_period = run.steps_per_period.map_or(Ok(DEFAULT_RK4_STEPS), |s| {
+                positive("run.steps_per_period", s)
+            })?;
+            Ok(Method::Rk4 { steps_per_period })
+        }
+        MethodName::Auto | MethodName::Dop853 => {
+            if let Some(s) = run.steps_per_period {
+                bail!("run.steps_per_period = {s} is not allowed with an adaptive method: allowed only with method = \"rk4\"");
+            }
+            let Method::Dop853 { rtol, atol } = Method::DEFAULT else {
+                unreachable!("the default method is DOP853")
+            };
+            let rtol = run.rtol.map_or(Ok(rtol), |v| positive("run.rtol", v))?;
+            let atol = run.atol.map_or(Ok(atol), |v| positive("run.atol", v))?;
+            Ok(Method::Dop853 { rtol, atol })
+        }
+    }
+}
+
+fn expect(e: RawExpect) -> Result<Expect> {
+    let tolerance_deg = e.tolerance_deg.unwrap_or(0.5);
+    if !(tolerance_deg.is_finite() && tolerance_deg > 0.0) {
+        return Err(out_of_range(
+            "expect.tolerance_deg",
+            tolerance_deg,
+            "a finite number > 0 (degrees)",
+        ));
+    }
+    let angle_deg = e
+        .angle_deg
+        .map(|a| finite("expect.angle_deg", a))
+        .transpose()?;
+    if let Some(a) = angle_deg {
+        if !e.kind.has_angle() {
+            bail!(
+                "expect.angle_deg = {a} is not allowed with kind = \"{}\": allowed only with rest, flutter, subharmonic or oscillation",
+                e.kind.name()
+            );
+        }
+    }
+    if let Some(n) = e.order {
+        if e.kind != ExpectKind::Subharmonic {
+            bail!(
+                "expect.order = {n} is not allowed with kind = \"{}\": allowed only with subharmonic",
+                e.kind.name()
+            );
+        }
+        if !(3..=16).contains(&n) {
+            return Err(out_of_range(
+                "expect.order",
+                n,
+                "an integer in [3, 16] (2 is flutter)",
+            ));
+        }
+    }
+    let direction = match e.direction {
+        None => None,
+        Some(d) if e.kind != ExpectKind::Rotation => bail!(
+            "expect.direction = {d} is not allowed with kind = \"{}\": allowed only with rotation",
+            e.kind.name()
+        ),
+        Some(d @ (1 | -1)) => Some(d as i8),
+        Some(d) => {
+            return Err(out_of_range(
+                "expect.direction",
+                d,
+                "1 (θ increasing, counter-clockwise) or -1",
+            ))
+        }
+    };
+    Ok(Expect {
+        kind: e.kind,
+        angle_deg,
+        tolerance_deg,
+        order: e.order,
+        direction,
+    })
+}
