@@ -9,8 +9,9 @@
 //! | [`error`] | parameter errors raised at the boundary of the API |
 //! | [`model`] | geometry → equivalent length, drive, dimensionless groups, equations of motion, equilibria of the averaged motion, R inferred from a settled angle |
 //! | [`stability`] | the four levels of stability theory: averaging, Mathieu series, harmonic balance, Floquet |
-//! | [`integrate`] | the `System` trait, work statistics, fixed-step RK4 |
+//! | [`integrate`] | the `System` trait, work statistics; RK4, DOP853 with dense output, Verlet and Yoshida compositions |
 //! | [`poly`] | small real polynomials: arithmetic and robust real-root isolation |
+//! | [`sim`] | the simulator: scenes, composed equations of motion, runs and outcomes |
 //! | [`real`] | the number formats (f64, f32) behind one trait, math through libm |
 //! | [`rig`] | the microcontroller's logic: drive generator, phase lock, fixed-point estimator, safety — tested on the host and on an emulated Cortex-M4 |
 //! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
@@ -36,6 +37,7 @@ pub mod math;
 pub mod model;
 pub mod poly;
 pub mod real;
+pub mod sim;
 pub mod rig;
 pub mod stability;
 
