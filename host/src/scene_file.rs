@@ -15,6 +15,7 @@ use serde::Deserialize;
 use std::path::Path;
 
 use crate::outcome::{Expect, ExpectKind};
+use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::model::{DriveAngle, Geometry};
 use kapitza_core::sim::scene::{
@@ -232,6 +233,9 @@ enum MethodName {
     Auto,
     Dop853,
     Rk4,
+    Verlet,
+    Yoshida4,
+    Yoshida6,
 }
 
 #[derive(Debug, Clone, Copy, Default, Deserialize)]
@@ -416,8 +420,11 @@ fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     let p = scene.physical().map_err(|e| anyhow!("{e}"))?;
     fidelity::decide(&scene, &p).map_err(|e| anyhow!("{e}"))?;
     let method = method(run)?;
-    if matches!(method, Method::Rk4 { .. }) && scene.effects.coulomb.is_some() {
-        bail!("run.method = \"rk4\" cannot run effects.coulomb: allowed \"dop853\" or \"auto\" (stick–slip needs event location)");
+    if !matches!(method, Method::Dop853 { .. }) && scene.effects.coulomb.is_some() {
+        bail!("run.method: a fixed-step method cannot run effects.coulomb: allowed \"dop853\" or \"auto\" (stick–slip needs event location)");
+    }
+    if matches!(method, Method::Symplectic { .. }) && p.c > 0.0 {
+        bail!("run.method: symplectic methods integrate undamped motion only: remove effects.viscous, or use \"dop853\" or \"rk4\"");
     }
     Ok(SceneFile {
         title: raw.title.unwrap_or_else(|| stem.to_string()),
@@ -536,21 +543,32 @@ fn method(run: &RawRun) -> Result<Method> {
             Err(out_of_range(key, v, "a finite number > 0"))
         }
     };
-    match run.method {
-        MethodName::Rk4 => {
-            for (key, v) in [("rtol", run.rtol), ("atol", run.atol)] {
-                if let Some(v) = v {
-                    bail!("run.{key} = {v} is not allowed with method = \"rk4\": allowed steps_per_period (rtol and atol are for \"dop853\")");
-                }
+    let fixed_step = |name: &str| -> Result<f64> {
+        for (key, v) in [("rtol", run.rtol), ("atol", run.atol)] {
+            if let Some(v) = v {
+                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\")");
             }
-            let steps_per_period = run.steps_per_period.map_or(Ok(DEFAULT_RK4_STEPS), |s| {
-                positive("run.steps_per_period", s)
-            })?;
-            Ok(Method::Rk4 { steps_per_period })
         }
+        run.steps_per_period.map_or(Ok(DEFAULT_RK4_STEPS), |s| {
+            positive("run.steps_per_period", s)
+        })
+    };
+    let symplectic = |scheme, name| {
+        Ok(Method::Symplectic {
+            scheme,
+            steps_per_period: fixed_step(name)?,
+        })
+    };
+    match run.method {
+        MethodName::Rk4 => Ok(Method::Rk4 {
+            steps_per_period: fixed_step("rk4")?,
+        }),
+        MethodName::Verlet => symplectic(Symplectic::Verlet, "verlet"),
+        MethodName::Yoshida4 => symplectic(Symplectic::Yoshida4, "yoshida4"),
+        MethodName::Yoshida6 => symplectic(Symplectic::Yoshida6, "yoshida6"),
         MethodName::Auto | MethodName::Dop853 => {
             if let Some(s) = run.steps_per_period {
-                bail!("run.steps_per_period = {s} is not allowed with an adaptive method: allowed only with method = \"rk4\"");
+                bail!("run.steps_per_period = {s} is not allowed with an adaptive method: allowed only with a fixed-step method (rk4, verlet, yoshida4, yoshida6)");
             }
             let Method::Dop853 { rtol, atol } = Method::DEFAULT else {
                 unreachable!("the default method is DOP853")

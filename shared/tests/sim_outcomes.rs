@@ -95,3 +95,108 @@ fn rk4_and_f32_agree_on_the_outcome() {
     let got = rest_deg(simulate(&scene, &f32, &mut Discard).unwrap().outcome);
     assert!((got - reference).abs() < 0.01, "f32 {got} vs {reference}");
 }
+
+/// An undamped averaged run: the symplectic methods and DOP853 agree on the end state.
+fn undamped_averaged() -> Scene {
+    let mut s = tilted();
+    s.effects.viscous = None;
+    s.fidelity = FidelityChoice::Fixed(Fidelity::Averaged);
+    s.length = RunLength::Periods(500.0);
+    s
+}
+
+#[test]
+fn symplectic_methods_agree_with_dop853() {
+    use kapitza_core::integrate::Symplectic;
+    let scene = undamped_averaged();
+    let quiet = |method| Options {
+        method,
+        classify: false,
+        ..Options::default()
+    };
+    let reference = simulate(
+        &scene,
+        &quiet(Method::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+        }),
+        &mut Discard,
+    )
+    .unwrap();
+    // Halving the step must cut the error by 2^order (Verlet 2, Yoshida 4 and 6: the methods'
+    // orders), measured against DOP853 at rtol 1e-12.
+    // Steps per drive period chosen so each method is in its asymptotic regime (error < 1e-3).
+    for (scheme, order, spp) in [
+        (Symplectic::Verlet, 2, 8.0),
+        (Symplectic::Yoshida4, 4, 2.0),
+        (Symplectic::Yoshida6, 6, 1.0),
+    ] {
+        let err = |spp: f64| {
+            let m = Method::Symplectic {
+                scheme,
+                steps_per_period: spp,
+            };
+            (simulate(&scene, &quiet(m), &mut Discard).unwrap().end.1 - reference.end.1).abs()
+        };
+        let (coarse, fine) = (err(spp), err(2.0 * spp));
+        let measured = (coarse / fine).log2();
+        std::println!("{scheme:?}: {coarse:.3e} -> {fine:.3e}, order {measured:.2}");
+        assert!(
+            (measured - order as f64).abs() < 0.3,
+            "{scheme:?}: order {measured}"
+        );
+    }
+}
+
+#[test]
+fn symplectic_refuses_damping() {
+    use kapitza_core::integrate::Symplectic;
+    let o = Options {
+        method: Method::Symplectic {
+            scheme: Symplectic::Verlet,
+            steps_per_period: 20.0,
+        },
+        ..Options::default()
+    };
+    assert!(matches!(
+        simulate(&tilted(), &o, &mut Discard),
+        Err(kapitza_core::sim::SimError::Unsupported(_))
+    ));
+}
+
+#[test]
+fn one_turn_per_period_is_rotation() {
+    // A hanging point pendulum spun at ω = 15 rad/s under a vertical drive locks into one turn per
+    // drive period; its wrapped strobes are all equal, which must not read as rest.
+    let scene = Scene {
+        pendulum: Geometry::point_mass(0.2).unwrap(),
+        drive: DriveSpec {
+            amplitude: 0.06,
+            frequency: DriveFrequency::Omega(15.0),
+            angle: DriveAngle::from_deg(0.0).unwrap(),
+        },
+        gravity: 9.81,
+        initial_angle: 0.0,
+        initial_rate: 15.0,
+        length: RunLength::Periods(600.0),
+        fidelity: FidelityChoice::Fixed(Fidelity::Full),
+        effects: Effects {
+            viscous: Some(Viscous::Q(20.0)),
+            ..Effects::default()
+        },
+    };
+    let r = simulate(&scene, &Options::default(), &mut Discard).unwrap();
+    assert!(
+        matches!(
+            r.outcome,
+            Outcome::Rotation {
+                periods_per_turn: 1,
+                ..
+            }
+        ),
+        "{:?}",
+        r.outcome
+    );
+    // `periods = 600` gives exactly 600 strobes (no loss to rounding).
+    assert_eq!(r.strobes, 600);
+}

@@ -11,10 +11,11 @@ use crate::outcome::{self, Judged, OutcomeOut};
 use crate::record::{self, Collect};
 use crate::scene_file::{self, SceneFile};
 use crate::{csv_out, plot};
+use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::model::{equilibria, Stability};
 use kapitza_core::sim::scene::{Fidelity, FidelityChoice};
-use kapitza_core::sim::{simulate, Format, Method, Options, Report, Scene};
+use kapitza_core::sim::{simulate, Format, Method, Options, Report};
 
 /// Simulate a scene file (TOML; keys in docs/scenes.md) and report the outcome: rest (at which
 /// angle), flutter, subharmonic, rotation, chaotic tumbling or oscillation.
@@ -123,15 +124,6 @@ pub struct EndOut {
     pub rate: f64,
 }
 
-/// The averaged model's R: a slider-crank's second harmonic (A²/4b) cos 2ϕ adds
-/// R·4(a2/a1)² = R·A²/(4b²) (kapitza_core::sim::eom, the same formula as its `averaged_r`).
-fn averaged_r(scene: &Scene, r: f64) -> f64 {
-    scene.effects.slider_crank.map_or(r, |b| {
-        let ratio = scene.drive.amplitude / (4.0 * b);
-        r * (1.0 + 4.0 * ratio * ratio)
-    })
-}
-
 fn fidelity_name(f: Fidelity) -> &'static str {
     match f {
         Fidelity::Full => "full",
@@ -194,7 +186,7 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
     let p = &report.physical;
     let scene = &file.scene;
     let outcome = OutcomeOut::from(report.outcome);
-    let r_effective = averaged_r(scene, p.r);
+    let r_effective = kapitza_core::sim::run::averaged_r(scene, p);
     let eqs = equilibria(r_effective, scene.drive.angle).context("predicted equilibria")?;
     let predicted = eqs
         .as_slice()
@@ -216,6 +208,17 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
     let (method, rtol, atol, steps_per_period) = match file.method {
         Method::Dop853 { rtol, atol } => ("dop853", Some(rtol), Some(atol), None),
         Method::Rk4 { steps_per_period } => ("rk4", None, None, Some(steps_per_period)),
+        Method::Symplectic {
+            scheme,
+            steps_per_period,
+        } => {
+            let name = match scheme {
+                Symplectic::Verlet => "verlet",
+                Symplectic::Yoshida4 => "yoshida4",
+                Symplectic::Yoshida6 => "yoshida6",
+            };
+            (name, None, None, Some(steps_per_period))
+        }
     };
     let (t_end, theta_end, rate_end) = report.end;
     Ok(Summary {

@@ -174,7 +174,8 @@ pub fn classify(
     let reference = strobes.last(0).theta;
     let centre =
         |p: usize| math::wrap_pi((0..p).map(|i| strobes.last(i).mean).sum::<f64>() / p as f64);
-    if range(&|s| math::wrap_pi(s.theta - reference)) <= TOL && range(&|s| s.rate / omega) <= TOL {
+    // Unwrapped: a rotation of exactly one turn per period has equal *wrapped* strobes.
+    if range(&|s| s.theta - reference) <= TOL && range(&|s| s.rate / omega) <= TOL {
         return Outcome::Rest {
             angle: centre(half.min(64)),
         };
@@ -322,6 +323,22 @@ mod tests {
             classify(&sub, W, false, no_lyapunov),
             Outcome::Subharmonic { order: 5, .. }
         ));
+        // One turn per period is rotation, not rest (its wrapped strobes are all equal).
+        let spin = fill(
+            |k| Strobe {
+                theta: 0.3 + k as f64 * math::TAU,
+                rate: 15.0,
+                mean: 0.0,
+            },
+            200,
+        );
+        assert_eq!(
+            classify(&spin, W, false, no_lyapunov),
+            Outcome::Rotation {
+                direction: 1,
+                periods_per_turn: 1
+            }
+        );
         // One turn clockwise every 2 periods.
         let rot = fill(
             |k| Strobe {

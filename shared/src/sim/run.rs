@@ -17,7 +17,8 @@ use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
 use crate::integrate::{
-    rk4_observe, Control, Dop853, IntegrateError, Stats, Step, StepControl, System,
+    rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
+    StepControl, Symplectic, System,
 };
 use crate::{math, Real};
 use core::fmt;
@@ -29,6 +30,12 @@ pub enum Method {
     Rk4 { steps_per_period: f64 },
     /// Adaptive Dormand–Prince 8(5,3) with dense output.
     Dop853 { rtol: f64, atol: f64 },
+    /// A symplectic method (Störmer–Verlet or a Yoshida composition) with a fixed step of
+    /// T/steps_per_period: undamped scenes only.
+    Symplectic {
+        scheme: Symplectic,
+        steps_per_period: f64,
+    },
 }
 
 impl Method {
@@ -165,15 +172,29 @@ pub fn simulate<Rec: Recorder>(
     scene.check()?;
     let p = scene.physical()?;
     let decision = fidelity::decide(scene, &p)?;
-    check_method(scene, options)?;
+    check_method(scene, &p, options)?;
     match options.format {
         Format::F64 => run_format::<f64, Rec>(scene, &p, decision, options, rec),
         Format::F32 => run_format::<f32, Rec>(scene, &p, decision, options, rec),
     }
 }
 
-fn check_method(scene: &Scene, options: &Options) -> Result<(), SimError> {
+fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), SimError> {
     match options.method {
+        Method::Symplectic {
+            steps_per_period, ..
+        } => {
+            if !(steps_per_period.is_finite() && steps_per_period > 0.0) {
+                return Err(SimError::Unsupported(
+                    "run.steps_per_period must be a finite number > 0",
+                ));
+            }
+            if p.c > 0.0 || scene.effects.coulomb.is_some() {
+                return Err(SimError::Unsupported(
+                    "symplectic methods integrate undamped motion only: drop effects.viscous and effects.coulomb, or use dop853 or rk4",
+                ));
+            }
+        }
         Method::Rk4 { steps_per_period } => {
             if !(steps_per_period.is_finite() && steps_per_period > 0.0) {
                 return Err(SimError::Unsupported(
@@ -238,7 +259,8 @@ fn run_format<R: Real, Rec: Recorder>(
 ) -> Result<Report, SimError> {
     let sched = schedule(scene, p);
     let t_end = scene.duration(p.omega);
-    let strobes_total = libm::floor(sched.state(t_end).phase / math::TAU) as u64;
+    // `periods = 4000` must give 4000 strobes, not 3999 through rounding of ω·t_end/2π.
+    let strobes_total = libm::floor(sched.state(t_end).phase / math::TAU + 1e-9) as u64;
     let ctx = Context {
         method: options.method,
         y0: (scene.initial_angle, scene.initial_rate),
@@ -381,8 +403,9 @@ impl<'c, 'r, R: Real, Rec: Recorder> Job<R> for Integrate<'c, 'r, Rec> {
     }
 }
 
-/// R of the averaged model: R (1 + 4 (a2/a1)²) with a slider-crank (see [`super::eom`]).
-pub(super) fn averaged_r(scene: &Scene, p: &Physical) -> f64 {
+/// R of the averaged model: R (1 + 4 (a2/a1)²) = R (1 + A²/(4b²)) with a slider-crank of rod
+/// length b (see [`super::eom`]); R itself otherwise.
+pub fn averaged_r(scene: &Scene, p: &Physical) -> f64 {
     let ratio = second_harmonic(scene, p) / (p.amplitude / p.ell);
     p.r * (1.0 + 4.0 * ratio * ratio)
 }
@@ -430,6 +453,38 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             })?;
             (sol.t, sol.y, sol.stats)
         }
+        Method::Symplectic {
+            scheme,
+            steps_per_period,
+        } => {
+            let n = libm::round(ctx.t_end / ctx.period * steps_per_period).max(1.0) as u64;
+            let h = ctx.t_end / n as f64;
+            let force = AtRest(&sys);
+            let x0 = Phase {
+                q: [y0[0]],
+                v: [y0[1]],
+            };
+            let mut prev = (0.0, y0);
+            let mut extra = 0u64;
+            let sol = symplectic_fixed(scheme, &force, 0.0, x0, h, n, |t, x| {
+                let y = [x.q[0], x.v[0]];
+                let mut interp = LazyHermite {
+                    sys: &sys,
+                    t0: prev.0,
+                    t1: t,
+                    y0: prev.1,
+                    y1: y,
+                    ready: None,
+                    evals: &mut extra,
+                };
+                sampler.step(t, pair(&y), &mut interp);
+                prev = (t, y);
+                Control::Continue
+            });
+            let mut work = sol.stats;
+            work.rhs_evals += extra;
+            (sol.t, [sol.y.q[0], sol.y.v[0]], work)
+        }
         Method::Rk4 { steps_per_period } => {
             let n = libm::round(ctx.t_end / ctx.period * steps_per_period).max(1.0) as u64;
             let h = ctx.t_end / n as f64;
@@ -466,6 +521,19 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
         end,
         sticks: None,
     })
+}
+
+/// An undamped equation seen as a force: θ'' = a(t, θ), evaluated at θ' = 0 (the extras of an
+/// undamped scene ignore θ', which [`check_method`] ensures before a symplectic method runs).
+struct AtRest<'s, S>(&'s S);
+
+impl<R: Real, S: System<2, R>> Force<1, R> for AtRest<'_, S> {
+    #[inline(always)]
+    fn accel(&self, t: f64, q: &[R; 1], a: &mut [R; 1]) {
+        let mut dy = [R::ZERO; 2];
+        self.0.rhs(t, &[q[0], R::ZERO], &mut dy);
+        a[0] = dy[1];
+    }
 }
 
 /// Hermite interpolation whose end derivatives are evaluated only if a sample falls inside the

@@ -1,0 +1,44 @@
+//! Every shipped scene in `scenes/` gives the outcome its `[expect]` table states.
+//!
+//! The expectations name their sources in each file (closed forms of SPEC §3, the SPEC §4 table,
+//! Floquet boundaries from `kapitza boundary`); this test runs them exactly as a user would,
+//! `kapitza simulate FILE --check`.
+
+use std::path::PathBuf;
+
+fn scenes() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn every_shipped_scene_meets_its_expectation() {
+    let files = scenes();
+    // One per outcome kind and per simulable SPEC claim: guard against the directory emptying.
+    assert!(files.len() >= 15, "{} scenes", files.len());
+    let mut kinds = std::collections::BTreeSet::new();
+    for f in &files {
+        let mut out = Vec::new();
+        let path = f.to_str().unwrap();
+        let result = kapitza::run(["kapitza", "simulate", path, "--check", "--json"], &mut out);
+        let v: serde_json::Value =
+            serde_json::from_slice(&out).unwrap_or_else(|e| panic!("{path}: {e}"));
+        assert!(
+            result.is_ok(),
+            "{path}: {:?}\n{}",
+            result.err().map(|e| e.to_string()),
+            v["expect"]
+        );
+        assert_eq!(v["expect"]["met"], true, "{path}");
+        kinds.insert(v["outcome"]["kind"].as_str().unwrap().to_string());
+    }
+    for kind in ["rest", "flutter", "subharmonic", "rotation", "chaotic"] {
+        assert!(kinds.contains(kind), "no shipped scene shows {kind}");
+    }
+}
