@@ -37,8 +37,8 @@ pub mod math;
 pub mod model;
 pub mod poly;
 pub mod real;
-pub mod sim;
 pub mod rig;
+pub mod sim;
 pub mod stability;
 
 pub use error::ParamError;

@@ -4,6 +4,7 @@
 //! | module | concept |
 //! |---|---|
 //! | [`period`] | synchronous averaging over each drive period: the slow angle φ̄, and the wobble's I/Q |
+//! | [`period_f32`] | the same in f32, only for the accuracy-and-cost comparison |
 //! | [`swing`] | extrema of φ̄ → slow frequency ωd, decay σ, ωp = √(ωd² + σ²) |
 //! | [`settle`] | settled flag, equilibrium angle, R in situ, the wobble's check of A |
 //!
@@ -12,6 +13,7 @@
 //! construction; physical outputs saturate.
 
 pub mod period;
+pub mod period_f32;
 pub mod settle;
 pub mod swing;
 
@@ -73,6 +75,20 @@ pub struct Estimate {
 /// Radians → 2^-32 turn.
 fn rad_to_bits(x: f64) -> i64 {
     libm::round(x / crate::math::TAU * 4_294_967_296.0) as i64
+}
+
+/// Angular velocity (rad/s, I16F16) of an angle change `du` (2^-32 turn) over `dt_us`;
+/// saturates at ±32768 rad/s, never wraps.
+///
+/// ```text
+/// Q16 rad/s = Δu·(2π/2^32)·(10⁶/Δt)·2^16 = Δu·2π·10⁶/(2^16·Δt)     (2π·10⁶ carried as 6 283 185 307/10³)
+/// ```
+/// In i128: Δu may be many turns for a rotating pendulum.
+pub fn slow_rate(du: i64, dt_us: u32) -> RadPerSec {
+    const TWO_PI_E9: i128 = 6_283_185_307;
+    let dt = i128::from(dt_us.max(1));
+    let v = i128::from(du) * TWO_PI_E9 / (dt * 65_536 * 1000);
+    RadPerSec::from_bits(v.clamp(i128::from(i32::MIN), i128::from(i32::MAX)) as i32)
 }
 
 /// The estimator.
@@ -139,14 +155,7 @@ impl Estimator {
         e.periods = e.periods.saturating_add(1);
         e.phi = pm.mean;
         if let Some(prev) = self.last {
-            // rad/s in Q16 = Δu·(2π/2^32)·(10⁶/Δt)·2^16 = Δu·2π·10⁶/(2^16·Δt); 2π·10⁶ is carried
-            // as 6 283 185 307/10³. i128: Δu may be many turns for a rotating pendulum.
-            const TWO_PI_E9: i128 = 6_283_185_307;
-            let du = i128::from(pm.unwrapped.wrapping_sub(prev.unwrapped));
-            let dt = i128::from(pm.dt_us.max(1));
-            let v = du * TWO_PI_E9 / (dt * 65_536 * 1000);
-            let v = v.clamp(i128::from(i32::MIN), i128::from(i32::MAX)) as i32;
-            e.phi_rate = RadPerSec::from_bits(v); // saturated, never wrapped
+            e.phi_rate = slow_rate(pm.unwrapped.wrapping_sub(prev.unwrapped), pm.dt_us);
         }
         self.last = Some(*pm);
         self.swing.push(pm.unwrapped, pm.t_us);

@@ -17,7 +17,9 @@
 //! cosine, |Σ| < 2^14 · 2^45 · 2^15 = 2^74 — too big, so the offsets are first reduced to Q20
 //! turns (>> 12) before the product: |Σ| < 2^14 · 2^33 · 2^15 = 2^62. Sums saturate regardless.
 
-use crate::rig::fixed::{trig, Angle};
+use crate::rig::fixed::trig::{Poly, SinCos};
+use crate::rig::fixed::Angle;
+use core::marker::PhantomData;
 
 /// Longest period averaged (samples); longer ones (drive slower than fs/2^14, 0.6 Hz at 10 kHz)
 /// are dropped.
@@ -26,9 +28,10 @@ pub const MAX_SAMPLES: u32 = 1 << 14;
 /// One drive period's average.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PeriodMean {
-    /// Stamp of the period's last sample (µs, wrapping).
+    /// Stamp of the middle of the period (µs, wrapping): halfway between its first and last
+    /// samples, where the boxcar mean of a steadily moving angle belongs.
     pub t_us: u32,
-    /// Duration since the previous period's end (µs).
+    /// Time since the previous period's middle (µs).
     pub dt_us: u32,
     pub samples: u32,
     /// The slow angle φ̄ (wrapped).
@@ -40,9 +43,9 @@ pub struct PeriodMean {
     pub q: i64,
 }
 
-/// The running sums of the current period.
+/// The running sums of the current period; `T` is the sin/cos used for the demodulation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct PeriodAverager {
+pub struct PeriodAverager<T = Poly> {
     started: bool,
     last_theta: Angle,
     last_psi: u32,
@@ -53,12 +56,37 @@ pub struct PeriodAverager {
     sum: i64,
     sum_c: i64,
     sum_s: i64,
-    t_prev_end: Option<u32>,
+    t_first: u32,
+    t_last: u32,
+    t_prev_mid: Option<u32>,
+    trig: PhantomData<T>,
 }
 
 impl PeriodAverager {
     pub fn new() -> Self {
         Self::default()
+    }
+}
+
+impl<T: SinCos> PeriodAverager<T> {
+    /// With another sin/cos (for the cost comparison).
+    pub fn with_trig() -> Self {
+        Self {
+            started: false,
+            last_theta: Angle::ZERO,
+            last_psi: 0,
+            u: 0,
+            u_start: 0,
+            theta_start: Angle::ZERO,
+            n: 0,
+            sum: 0,
+            sum_c: 0,
+            sum_s: 0,
+            t_first: 0,
+            t_last: 0,
+            t_prev_mid: None,
+            trig: PhantomData,
+        }
     }
 
     /// One sample: stamp, pendulum angle, drive phase. Returns a mean when a period completes.
@@ -71,6 +99,8 @@ impl PeriodAverager {
             self.last_psi = psi_u;
             self.u = i64::from(theta.to_bits()); // the unwrapped scale starts at the first angle
             self.begin(theta);
+            self.t_first = t_us;
+            self.t_last = t_us;
             return None;
         }
         self.u = self
@@ -81,9 +111,11 @@ impl PeriodAverager {
         self.last_psi = psi_u;
         let mut out = None;
         if wrapped {
-            out = self.finish(t_us);
+            out = self.finish();
             self.begin(theta);
+            self.t_first = t_us;
         }
+        self.t_last = t_us;
         self.accumulate(psi);
         out
     }
@@ -105,7 +137,7 @@ impl PeriodAverager {
         }
         let d = self.u.wrapping_sub(self.u_start);
         self.sum = self.sum.saturating_add(d);
-        let (s, c) = trig::sin_cos(psi);
+        let (s, c) = T::sin_cos(psi);
         let d20 = d >> 12; // Q20 turns
         let (s15, c15) = (i64::from(s.to_bits() >> 15), i64::from(c.to_bits() >> 15));
         self.sum_c = self.sum_c.saturating_add(d20 * c15);
@@ -113,20 +145,23 @@ impl PeriodAverager {
         self.n += 1;
     }
 
-    fn finish(&mut self, t_end: u32) -> Option<PeriodMean> {
-        let prev = self.t_prev_end.replace(t_end);
+    fn finish(&mut self) -> Option<PeriodMean> {
+        let mid = self
+            .t_first
+            .wrapping_add(self.t_last.wrapping_sub(self.t_first) / 2);
+        let prev = self.t_prev_mid.replace(mid);
         let n = self.n;
         if n == 0 || n > MAX_SAMPLES {
             return None;
         }
-        let dt = t_end.wrapping_sub(prev?);
+        let dt = mid.wrapping_sub(prev?);
         let n64 = i64::from(n);
         let off = crate::rig::fixed::approx::div_round(self.sum, n64);
         // (2/N) Σ d20·c15 / 2^15  →  Q20 turns
         let i = crate::rig::fixed::approx::div_round(self.sum_c, n64 << 14);
         let q = crate::rig::fixed::approx::div_round(self.sum_s, n64 << 14);
         Some(PeriodMean {
-            t_us: t_end,
+            t_us: mid,
             dt_us: dt,
             samples: n,
             mean: self.theta_start + Angle::from_bits(off as i32),

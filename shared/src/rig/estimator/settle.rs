@@ -32,6 +32,9 @@ pub struct Settle {
     quiet_needed: u32,
     min: i64,
     max: i64,
+    /// First angle of the block: sums run relative to it, so a large unwrapped angle (after
+    /// many turns) cannot overflow them.
+    base: Option<i64>,
     sum: i64,
     sum_i: i64,
     sum_q: i64,
@@ -59,6 +62,7 @@ impl Settle {
             quiet_needed: quiet_needed.max(1),
             min: i64::MAX,
             max: i64::MIN,
+            base: None,
             sum: 0,
             sum_i: 0,
             sum_q: 0,
@@ -76,7 +80,8 @@ impl Settle {
     pub fn push(&mut self, p: &PeriodMean) {
         self.min = self.min.min(p.unwrapped);
         self.max = self.max.max(p.unwrapped);
-        self.sum = self.sum.saturating_add(p.unwrapped);
+        let base = *self.base.get_or_insert(p.unwrapped);
+        self.sum = self.sum.saturating_add(p.unwrapped.wrapping_sub(base));
         self.sum_i = self.sum_i.saturating_add(p.i);
         self.sum_q = self.sum_q.saturating_add(p.q);
         self.n += 1;
@@ -86,7 +91,7 @@ impl Settle {
             if self.max.abs_diff(self.min) <= self.band {
                 self.quiet += 1;
                 self.last = Some(Block {
-                    mean: approx::div_round(self.sum, n),
+                    mean: base.wrapping_add(approx::div_round(self.sum, n)),
                     i: approx::div_round(self.sum_i, n),
                     q: approx::div_round(self.sum_q, n),
                 });

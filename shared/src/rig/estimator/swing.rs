@@ -138,7 +138,8 @@ impl SwingTracker {
             return self.ext;
         };
         let x0 = self.ext.x;
-        let den = a.x - 2 * x0 + b.x;
+        // Differences first: x itself may be far from 0 after many turns.
+        let den = (a.x - x0) + (b.x - x0);
         if den == 0 {
             return self.ext;
         }

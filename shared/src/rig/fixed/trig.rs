@@ -19,6 +19,56 @@
 
 use super::{Angle, Unit};
 
+/// A Q30 sin/cos, chosen at compile time (so a kernel generic over it pays no indirection):
+/// the rig uses [`Poly`]; [`Table`] exists for the cost comparison.
+pub trait SinCos {
+    fn sin_cos(a: Angle) -> (Unit, Unit);
+}
+
+/// [`sin_cos`]: the Taylor polynomial.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Poly;
+/// [`sin_cos_table`]: the quarter-wave table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Table;
+
+impl SinCos for Poly {
+    #[inline]
+    fn sin_cos(a: Angle) -> (Unit, Unit) {
+        sin_cos(a)
+    }
+}
+impl SinCos for Table {
+    #[inline]
+    fn sin_cos(a: Angle) -> (Unit, Unit) {
+        sin_cos_table(a)
+    }
+}
+
+/// An f32 sin/cos of an [`Angle`], for the f32 variants of the cost comparison.
+pub trait SinCosF32 {
+    fn sin_cos(a: Angle) -> (f32, f32);
+}
+/// [`sin_cos_f32_poly`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PolyF32;
+/// [`sin_cos_f32_micromath`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Micromath;
+
+impl SinCosF32 for PolyF32 {
+    #[inline]
+    fn sin_cos(a: Angle) -> (f32, f32) {
+        sin_cos_f32_poly(a)
+    }
+}
+impl SinCosF32 for Micromath {
+    #[inline]
+    fn sin_cos(a: Angle) -> (f32, f32) {
+        sin_cos_f32_micromath(a)
+    }
+}
+
 /// π/2 in Q32: x·2^30 = r·(π/2)·2^30/2^30… i.e. x_Q30 = r·π/2 for r in 2^-32 turns.
 const HALF_PI_Q32: i64 = 6_746_518_852; // round(π/2 · 2^32)
 

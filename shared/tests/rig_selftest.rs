@@ -1,0 +1,21 @@
+//! The on-target scenarios (`rig::selftest`) on the host: each must produce its expected digest,
+//! the same one the emulated Cortex-M4F must produce (`qemu/`), so host and target agree bit
+//! for bit. Prints every digest (`-- --nocapture`) for regeneration after a deliberate change.
+
+use kapitza_core::rig::selftest::CASES;
+
+#[test]
+fn digests_match() {
+    let mut bad = Vec::new();
+    for c in CASES {
+        let got = (c.run)();
+        println!("{:<22} 0x{got:016x}", c.name);
+        if got != c.expected {
+            bad.push((c.name, got, c.expected));
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "digest mismatches (name, got, expected): {bad:x?}"
+    );
+}
