@@ -44,6 +44,8 @@ pub trait Real:
     /// (sin ϕ, cos ϕ) of a drive phase kept in f64. f64 evaluates it directly; f32 first
     /// reduces ϕ to (−π, π] in f64, since the phase grows without bound and f32 would lose it.
     fn sin_cos_phase(phase: f64) -> (Self, Self);
+    /// cos ϕ alone, reduced the same way (cheaper than both when only it is needed).
+    fn cos_phase(phase: f64) -> Self;
 
     fn max(self, other: Self) -> Self {
         if self > other {
@@ -107,6 +109,10 @@ impl Real for f64 {
     fn sin_cos_phase(phase: f64) -> (Self, Self) {
         libm::sincos(phase)
     }
+    #[inline]
+    fn cos_phase(phase: f64) -> Self {
+        libm::cos(phase)
+    }
 }
 
 impl Real for f32 {
@@ -154,6 +160,10 @@ impl Real for f32 {
     #[inline]
     fn sin_cos_phase(phase: f64) -> (Self, Self) {
         libm::sincosf(crate::math::wrap_pi(phase) as f32)
+    }
+    #[inline]
+    fn cos_phase(phase: f64) -> Self {
+        libm::cosf(crate::math::wrap_pi(phase) as f32)
     }
 }
 

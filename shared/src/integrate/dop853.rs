@@ -225,7 +225,13 @@ impl Dop853 {
                 return Err(IntegrateError::NonFinite { t });
             }
 
-            let fac_err = math::powf(err, 0.125 - 0.2 * self.beta);
+            // err^(1/8 − 0.2β); with the standard controller (β = 0) three square roots give
+            // err^(1/8) at a fraction of powf's cost, which matters on cheap right-hand sides.
+            let fac_err = if self.beta == 0.0 {
+                math::sqrt(math::sqrt(math::sqrt(err)))
+            } else {
+                math::powf(err, 0.125 - 0.2 * self.beta)
+            };
             if err > 1.0 {
                 // Rejected: shrink (never by more than FAC_MIN) and retry.
                 h /= (fac_err / SAFETY).min(1.0 / FAC_MIN);
@@ -262,8 +268,8 @@ impl Dop853 {
                 return Ok(Solution { t, y, stats });
             }
 
-            let fac = (fac_err / math::powf(err_prev, self.beta) / SAFETY)
-                .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+            let memory = if self.beta == 0.0 { 1.0 } else { math::powf(err_prev, self.beta) };
+            let fac = (fac_err / memory / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
             let mut h_new = (h.abs() / fac).min(h_max);
             if after_reject {
                 h_new = h_new.min(h.abs());

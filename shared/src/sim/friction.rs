@@ -53,6 +53,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
         ctx.out_dt,
         ctx.sensor.clone(),
         ctx.t_end,
+        ctx.classify,
         rec,
     );
     sampler.start(ctx.y0.0, ctx.y0.1);

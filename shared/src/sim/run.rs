@@ -436,6 +436,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
         ctx.out_dt,
         ctx.sensor.clone(),
         ctx.t_end,
+        ctx.classify,
         rec,
     );
     sampler.start(ctx.y0.0, ctx.y0.1);

@@ -33,11 +33,20 @@ pub trait Recorder {
     fn sensed(&mut self, _t: f64, _angle: f64) {}
     /// Fraction of the run done, about every 1 %.
     fn progress(&mut self, _done: f64) {}
+    /// Whether this recorder wants the stroboscopic samples; if neither it nor the classifier
+    /// does, they are not computed at all.
+    fn wants_strobes(&self) -> bool {
+        true
+    }
 }
 
 /// A recorder that keeps nothing.
 pub struct Discard;
-impl Recorder for Discard {}
+impl Recorder for Discard {
+    fn wants_strobes(&self) -> bool {
+        false
+    }
+}
 
 /// The schedules of one run.
 pub struct Sampler<'a, Rec: Recorder> {
@@ -68,17 +77,27 @@ pub struct Sampler<'a, Rec: Recorder> {
 
 impl<'a, Rec: Recorder> Sampler<'a, Rec> {
     /// `strobes_total`: the number of strobes the run will see; `out_dt`: output interval (0 for
-    /// none).
+    /// none); `classify`: keep the analysis window (strobes with period means) for the classifier.
+    /// A run that neither classifies nor records strobes computes none.
     pub fn new(
         schedule: Schedule,
         strobes_total: u64,
         out_dt: f64,
         sensor: Option<Encoder>,
         t_end: f64,
+        classify: bool,
         rec: &'a mut Rec,
     ) -> Self {
-        let window_from = strobes_total.saturating_sub(WINDOW as u64 - 1).max(1);
-        let first = strobe_time(&schedule, 1);
+        let window_from = if classify {
+            strobes_total.saturating_sub(WINDOW as u64 - 1).max(1)
+        } else {
+            u64::MAX
+        };
+        let first = if classify || rec.wants_strobes() {
+            strobe_time(&schedule, 1)
+        } else {
+            f64::INFINITY
+        };
         let mut s = Self {
             schedule,
             next_k: 1,

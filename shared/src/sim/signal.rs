@@ -50,7 +50,7 @@ impl<R: Real> Steady<R> {
 impl<R: Real> DriveSignal<R> for Steady<R> {
     #[inline]
     fn accel(&self, t: f64) -> R {
-        -self.peak * R::sin_cos_phase(self.omega * t).1
+        -self.peak * R::cos_phase(self.omega * t)
     }
     #[inline]
     fn strength(&self, _t: f64) -> R {
