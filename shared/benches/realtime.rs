@@ -1,0 +1,149 @@
+//! Real-time factor: simulated seconds per wall second over 60 s of simulated time, at a
+//! final-state error of 1e-6 against a converged reference, for the full and the averaged model.
+//!
+//! Error: max(|Δθ|, |Δθ'|/ω) at the end, Δθ wrapped. Reference: DOP853 at rtol = atol = 1e-13,
+//! checked converged by its distance to rtol 1e-12 (printed; must be ≪ 1e-6). For each model the
+//! loosest DOP853 tolerance and the fewest RK4 steps per period that reach 1e-6 are found on a
+//! ladder, and the faster of the two is timed.
+//!
+//! Run: `cargo bench -p kapitza-core --bench realtime`. Figures: docs/performance.md.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use kapitza_core::math;
+use kapitza_core::model::{DriveAngle, Geometry};
+use kapitza_core::sim::sampling::Discard;
+use kapitza_core::sim::scene::{
+    DriveFrequency, DriveSpec, Effects, Fidelity, FidelityChoice, RunLength, Viscous,
+};
+use kapitza_core::sim::{simulate, Method, Options, Scene};
+use std::time::Instant;
+
+const SIMULATED: f64 = 60.0;
+const TARGET: f64 = 1e-6;
+
+/// The example scene (R ≈ 3.3 at 135°) with Q = 50, for 60 s.
+fn scene(fidelity: Fidelity) -> Scene {
+    Scene {
+        pendulum: Geometry::rod(0.20).unwrap(),
+        drive: DriveSpec {
+            amplitude: 0.0089,
+            frequency: DriveFrequency::Omega(330.0),
+            angle: DriveAngle::from_deg(135.0).unwrap(),
+        },
+        gravity: 9.81,
+        initial_angle: math::to_rad(100.0),
+        initial_rate: 0.0,
+        length: RunLength::Duration(SIMULATED),
+        fidelity: FidelityChoice::Fixed(fidelity),
+        effects: Effects {
+            viscous: Some(Viscous::Q(50.0)),
+            ..Effects::default()
+        },
+    }
+}
+
+fn options(method: Method) -> Options {
+    Options {
+        method,
+        classify: false,
+        ..Options::default()
+    }
+}
+
+fn end(s: &Scene, m: Method) -> (f64, f64) {
+    let r = simulate(s, &options(m), &mut Discard).unwrap();
+    (r.end.1, r.end.2)
+}
+
+fn error(a: (f64, f64), b: (f64, f64), omega: f64) -> f64 {
+    math::wrap_pi(a.0 - b.0)
+        .abs()
+        .max((a.1 - b.1).abs() / omega)
+}
+
+fn median_seconds(s: &Scene, m: Method) -> f64 {
+    let mut t: Vec<f64> = (0..7)
+        .map(|_| {
+            let start = Instant::now();
+            black_box(end(s, m));
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[3]
+}
+
+/// The cheapest method on the ladders that reaches TARGET.
+fn calibrate(fidelity: Fidelity) -> Method {
+    let s = scene(fidelity);
+    let omega = 330.0;
+    let reference = end(
+        &s,
+        Method::Dop853 {
+            rtol: 1e-13,
+            atol: 1e-13,
+        },
+    );
+    let check = end(
+        &s,
+        Method::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+        },
+    );
+    println!(
+        "{fidelity:?}: reference converged to {:.1e} (rtol 1e-12 vs 1e-13)",
+        error(reference, check, omega)
+    );
+    let dop = [
+        1e-4, 5e-5, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7, 2e-7, 1e-7, 5e-8, 2e-8, 1e-8, 5e-9, 2e-9,
+        1e-9,
+    ]
+    .into_iter()
+    .map(|tol| Method::Dop853 {
+        rtol: tol,
+        atol: tol,
+    })
+    .find(|&m| error(end(&s, m), reference, omega) <= TARGET)
+    .expect("some tolerance reaches 1e-6");
+    let rk4 = [
+        0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0, 48.0, 64.0,
+        96.0, 128.0, 192.0, 256.0,
+    ]
+    .into_iter()
+    .map(|spp| Method::Rk4 {
+        steps_per_period: spp,
+    })
+    .find(|&m| error(end(&s, m), reference, omega) <= TARGET)
+    .expect("some step reaches 1e-6");
+    let (td, tr) = (median_seconds(&s, dop), median_seconds(&s, rk4));
+    for (m, t) in [(dop, td), (rk4, tr)] {
+        println!(
+            "{fidelity:?} {m:?}: error {:.2e}, {:.3} ms, real-time factor {:.0}",
+            error(end(&s, m), reference, omega),
+            t * 1e3,
+            SIMULATED / t
+        );
+    }
+    if td <= tr {
+        dop
+    } else {
+        rk4
+    }
+}
+
+fn realtime(c: &mut Criterion) {
+    let mut g = c.benchmark_group("realtime_60s_at_1e-6");
+    g.sample_size(10);
+    for fidelity in [Fidelity::Full, Fidelity::Averaged] {
+        let m = calibrate(fidelity);
+        let s = scene(fidelity);
+        g.bench_function(format!("{fidelity:?}"), |b| {
+            b.iter(|| end(black_box(&s), m))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, realtime);
+criterion_main!(benches);
