@@ -40,6 +40,35 @@ proptest! {
         prop_assert_eq!(a, b);
     }
 
+    /// The rate limiter as a state machine under random retargeting: every tick the word moves
+    /// by at most the step, toward the target, and lands on it after ⌈|Δ|/step⌉ ticks; the phase
+    /// advances by the word's exact increment (⌊w·2^16/fs⌋ or one more), never jumps.
+    #[test]
+    fn rate_limiter_and_phase_continuity(
+        fs in 1_000u32..100_000,
+        step in 1u32..3_000,
+        targets in prop::collection::vec((0u32..(300 << 16), 1u32..3_000), 1..12),
+    ) {
+        let mut d = Dds::new(fs, step);
+        for (target, ticks) in targets {
+            d.set_target(target);
+            let need = u64::from(target.abs_diff(d.word())).div_ceil(u64::from(step));
+            for k in 0..u64::from(ticks) {
+                let (w0, p0) = (d.word(), d.phase());
+                let p1 = d.tick();
+                let w1 = d.word();
+                prop_assert!(w1.abs_diff(w0) <= step);
+                prop_assert!(w1.abs_diff(target) <= w0.abs_diff(target));
+                if k + 1 >= need {
+                    prop_assert_eq!(w1, target);
+                }
+                let inc = (u64::from(w1) << 16) / u64::from(fs);
+                let dp = u64::from((p1 - p0).to_turns_u32());
+                prop_assert!(dp == inc || dp == inc + 1, "phase step {} vs {}", dp, inc);
+            }
+        }
+    }
+
     /// advance(m) then advance(n) equals advance(m + n): with the previous property, stepping
     /// any number of ticks equals one jump (induction on the number of ticks).
     #[test]

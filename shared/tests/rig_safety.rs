@@ -1,10 +1,11 @@
-//! The safety supervisor as a state machine under random command and input sequences (proptest):
-//! no sequence pushes the rig past its limits, and a refused request changes nothing.
+//! The safety supervisor: scripted cases (refusals, link silence, e-stop, stall, over-current, the
+//! θd slew) and, as a state machine under random command and input sequences (proptest), no
+//! sequence pushes the rig past its limits and a refused request changes nothing.
 
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::dds::{word_from_omega, Dds};
 use kapitza_core::rig::fixed::{Amps, Angle, RadPerSec};
-use kapitza_core::rig::safety::{Fault, Inputs, Mode, Request, Supervisor};
+use kapitza_core::rig::safety::{Fault, Inputs, Mode, Refusal, Request, StopReason, Supervisor};
 use proptest::prelude::*;
 
 #[derive(Debug, Clone)]
@@ -55,15 +56,18 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
     #[test]
-    fn limits_hold_and_refusals_change_nothing(events in prop::collection::vec(event(), 1..40)) {
+    fn limits_hold_and_refusals_change_nothing(
+        t0: u32,
+        events in prop::collection::vec(event(), 1..40),
+    ) {
         let cfg = RigConfig::REFERENCE;
         let d = cfg.derived();
         let omega_max_word = word_from_omega(cfg.limits.omega_max).unwrap();
         let theta_step = (cfg.limits.drive_angle_rate_max_deg / 1000.0 / 360.0 * 4_294_967_296.0) as i64 + 1;
-        let mut sup = Supervisor::new(&cfg, Angle::from_deg(90.0), 0);
+        let mut sup = Supervisor::new(&cfg, Angle::from_deg(90.0), t0);
         let mut dds = Dds::new(cfg.sample_hz, d.dds_step);
-        let mut t: u32 = 0;
-        let mut last_link: u32 = 0;
+        let mut t: u32 = t0; // any start: the µs clock may wrap anywhere in the run
+        let mut last_link: u32 = t0;
         for ev in events {
             match ev {
                 Event::Req(r) => {
@@ -115,4 +119,139 @@ proptest! {
             }
         }
     }
+}
+
+// ---- scripted cases
+fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
+    Inputs {
+        estop: false,
+        current: Amps::ZERO,
+        crank_speed: RadPerSec::from_num(crank),
+        ref_omega: RadPerSec::from_num(ref_omega),
+        drive_stopped: stopped,
+    }
+}
+
+#[test]
+fn refusals_name_the_reason_and_change_nothing() {
+    let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
+    let before = s;
+    assert_eq!(
+        s.request(Request::Start { omega: 500.0 }),
+        Err(Refusal::OmegaAboveLimit {
+            requested: 500.0,
+            limit: 420.0
+        })
+    );
+    assert_eq!(
+        s.request(Request::SetDriveAngle { deg: 200.0 }),
+        Err(Refusal::DriveAngleOutOfRange {
+            requested: 200.0,
+            min: -10.0,
+            max: 190.0
+        })
+    );
+    assert_eq!(
+        s.request(Request::SetOmega { omega: 100.0 }),
+        Err(Refusal::WrongMode(Mode::Idle))
+    );
+    assert!(s.request(Request::Start { omega: f64::NAN }).is_err());
+    assert_eq!(s, before);
+}
+
+#[test]
+fn link_silence_soft_stops_and_never_restarts() {
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut t = 0u32;
+    for _ in 0..1000 {
+        t += 1000;
+        s.check(t, &quiet(300.0, 300.0, false));
+    }
+    assert_eq!(s.mode(), Mode::Running); // exactly 1 s of silence is not yet "more than"
+    t += 1000;
+    let out = s.check(t, &quiet(300.0, 300.0, false));
+    assert_eq!(s.mode(), Mode::Stopping(StopReason::LinkSilent));
+    assert!(out.active && !out.halt && out.target_word == 0); // ramp down, not a halt
+    t += 1000;
+    s.check(t, &quiet(0.0, 0.0, true));
+    assert_eq!(s.mode(), Mode::Idle);
+    assert_eq!(s.last_stop(), Some(StopReason::LinkSilent));
+    s.heard_from_link(t);
+    t += 1000;
+    s.check(t, &quiet(0.0, 0.0, true));
+    assert_eq!(s.mode(), Mode::Idle); // no automatic restart
+}
+
+#[test]
+fn estop_halts_at_once_and_latches() {
+    let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut inp = quiet(300.0, 300.0, false);
+    inp.estop = true;
+    let out = s.check(1000, &inp);
+    assert!(out.halt && !out.active);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::EStop));
+    assert_eq!(
+        s.request(Request::ClearFault),
+        Err(Refusal::EStopStillActive)
+    );
+    s.check(2000, &quiet(0.0, 0.0, true));
+    assert_eq!(
+        s.request(Request::Start { omega: 1.0 }),
+        Err(Refusal::Faulted(Fault::EStop))
+    );
+    s.request(Request::ClearFault).unwrap();
+    assert_eq!(s.mode(), Mode::Idle);
+}
+
+#[test]
+fn drive_angle_slews_within_the_travel() {
+    // From 185° to −5° (travel [−10°, 190°]): the shortest way (+170° through 270°) would
+    // leave the travel; the slew goes back through 90° at 30°/s: 190° in 6.33 s.
+    let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::from_deg(185.0), 0);
+    s.request(Request::SetDriveAngle { deg: -5.0 }).unwrap();
+    let mut t = 0;
+    let mut passed_90 = false;
+    for _ in 0..7000 {
+        t += 1000;
+        let th = s.check(t, &quiet(0.0, 0.0, true)).theta_d.to_deg();
+        let th = if th < -10.0 - 1e-6 { th + 360.0 } else { th };
+        assert!((-10.0 - 1e-6..=190.0 + 1e-6).contains(&th), "θd {th}");
+        passed_90 |= (th - 90.0).abs() < 0.1;
+    }
+    assert!(passed_90);
+    assert!((s.theta_d().to_deg() + 5.0).abs() < 1e-6);
+}
+
+#[test]
+fn stall_and_over_current_stop_after_their_debounce() {
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    // Crank at 10 % of the reference: stall after 300 ms, not before.
+    let mut t = 0;
+    for _ in 0..300 {
+        t += 1000;
+        s.heard_from_link(t);
+        s.check(t, &quiet(100.0, 10.0, false));
+        assert_eq!(s.mode(), Mode::Running, "t = {t}");
+    }
+    t += 1000;
+    assert!(s.check(t, &quiet(100.0, 10.0, false)).halt);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut inp = quiet(100.0, 100.0, false);
+    inp.current = Amps::from_num(5);
+    for _ in 0..20 {
+        t += 1000;
+        s.heard_from_link(t);
+        s.check(t, &inp);
+    }
+    assert_eq!(s.mode(), Mode::Running);
+    t += 1000;
+    s.check(t, &inp);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
 }

@@ -127,6 +127,13 @@ impl RigConfig {
                 "below 30000 rad/s (I16F16)",
             ));
         }
+        if l.omega_max >= crate::math::PI * f64::from(self.control_hz) {
+            return Err(too_big(
+                "omega_max",
+                l.omega_max,
+                "below pi*control_hz, where the crank speed measurement aliases",
+            ));
+        }
         positive("omega_rate_max", l.omega_rate_max)?;
         if super::dds::step_from_rate(l.omega_rate_max, self.sample_hz.max(1)) == 0 {
             return Err(too_big(

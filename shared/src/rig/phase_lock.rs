@@ -16,6 +16,10 @@
 //! With kp = 8/s, ki = 16/s², τ = 50 ms it crosses over near 8 rad/s with ≈ 60° of phase margin
 //! (the PI zero at ki/kp = 2 rad/s sits well below, the lag pole at 20 rad/s above), and a
 //! constant gain error leaves no steady phase error (the integrator holds it).
+//!
+//! The crank speed (for the stall guard) is the wrapped encoder difference per control tick, so
+//! it is unambiguous below half a turn per tick: |ω| < π·fc = 3142 rad/s at 1 kHz, 7× ω_max
+//! (checked by [`RigConfig::validate`]).
 
 use super::config::RigConfig;
 use super::fixed::{Amps, Angle, Duty, RadPerSec};

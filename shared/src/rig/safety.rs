@@ -163,6 +163,9 @@ pub struct Supervisor {
     // limits, fixed at construction
     omega_max: f64,
     theta_min_deg: f64,
+    theta_min: Angle,
+    /// The travel max − min in 2^-32 turn.
+    theta_span: i64,
     theta_max_deg: f64,
     theta_step: u32,
     current_max: Amps,
@@ -190,6 +193,10 @@ impl Supervisor {
             estop_seen: false,
             omega_max: l.omega_max,
             theta_min_deg: l.drive_angle_min_deg,
+            theta_min: Angle::from_deg(l.drive_angle_min_deg),
+            theta_span: libm::round(
+                (l.drive_angle_max_deg - l.drive_angle_min_deg) / 360.0 * 4_294_967_296.0,
+            ) as i64,
             theta_max_deg: l.drive_angle_max_deg,
             theta_step: libm::floor(per_tick_deg / 360.0 * 4_294_967_296.0).max(1.0) as u32,
             current_max: Amps::saturating_from_num(l.current_max),
@@ -342,9 +349,16 @@ impl Supervisor {
         if let Mode::Faulted(_) = self.mode {
             halt = true;
         } else {
-            // Slew θd toward its target by at most one step per tick (shortest way).
-            let d = (self.theta_target - self.theta).to_bits();
-            let step = self.theta_step.min(d.unsigned_abs()) as i32;
+            // Slew θd toward its target by at most one step per tick, along the mount's travel
+            // (measured from its lower end), never through the side it cannot reach; from
+            // outside the travel (only possible at power-up), the shortest way.
+            let off = |a: Angle| i64::from((a - self.theta_min).to_turns_u32());
+            let d = if off(self.theta) <= self.theta_span {
+                off(self.theta_target) - off(self.theta)
+            } else {
+                i64::from((self.theta_target - self.theta).to_bits())
+            };
+            let step = i64::from(self.theta_step).min(d.abs()) as i32;
             self.theta += Angle::from_bits(if d >= 0 { step } else { -step });
         }
         Output {
@@ -353,125 +367,5 @@ impl Supervisor {
             target_word: self.target_word,
             theta_d: self.theta,
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
-        Inputs {
-            estop: false,
-            current: Amps::ZERO,
-            crank_speed: RadPerSec::from_num(crank),
-            ref_omega: RadPerSec::from_num(ref_omega),
-            drive_stopped: stopped,
-        }
-    }
-
-    #[test]
-    fn refusals_name_the_reason_and_change_nothing() {
-        let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
-        let before = s;
-        assert_eq!(
-            s.request(Request::Start { omega: 500.0 }),
-            Err(Refusal::OmegaAboveLimit {
-                requested: 500.0,
-                limit: 420.0
-            })
-        );
-        assert_eq!(
-            s.request(Request::SetDriveAngle { deg: 200.0 }),
-            Err(Refusal::DriveAngleOutOfRange {
-                requested: 200.0,
-                min: -10.0,
-                max: 190.0
-            })
-        );
-        assert_eq!(
-            s.request(Request::SetOmega { omega: 100.0 }),
-            Err(Refusal::WrongMode(Mode::Idle))
-        );
-        assert!(s.request(Request::Start { omega: f64::NAN }).is_err());
-        assert_eq!(s, before);
-    }
-
-    #[test]
-    fn link_silence_soft_stops_and_never_restarts() {
-        let cfg = RigConfig::REFERENCE;
-        let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
-        s.request(Request::Start { omega: 300.0 }).unwrap();
-        let mut t = 0u32;
-        for _ in 0..1000 {
-            t += 1000;
-            s.check(t, &quiet(300.0, 300.0, false));
-        }
-        assert_eq!(s.mode(), Mode::Running); // exactly 1 s of silence is not yet "more than"
-        t += 1000;
-        let out = s.check(t, &quiet(300.0, 300.0, false));
-        assert_eq!(s.mode(), Mode::Stopping(StopReason::LinkSilent));
-        assert!(out.active && !out.halt && out.target_word == 0); // ramp down, not a halt
-        t += 1000;
-        s.check(t, &quiet(0.0, 0.0, true));
-        assert_eq!(s.mode(), Mode::Idle);
-        assert_eq!(s.last_stop(), Some(StopReason::LinkSilent));
-        s.heard_from_link(t);
-        t += 1000;
-        s.check(t, &quiet(0.0, 0.0, true));
-        assert_eq!(s.mode(), Mode::Idle); // no automatic restart
-    }
-
-    #[test]
-    fn estop_halts_at_once_and_latches() {
-        let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
-        s.request(Request::Start { omega: 300.0 }).unwrap();
-        let mut inp = quiet(300.0, 300.0, false);
-        inp.estop = true;
-        let out = s.check(1000, &inp);
-        assert!(out.halt && !out.active);
-        assert_eq!(s.mode(), Mode::Faulted(Fault::EStop));
-        assert_eq!(
-            s.request(Request::ClearFault),
-            Err(Refusal::EStopStillActive)
-        );
-        s.check(2000, &quiet(0.0, 0.0, true));
-        assert_eq!(
-            s.request(Request::Start { omega: 1.0 }),
-            Err(Refusal::Faulted(Fault::EStop))
-        );
-        s.request(Request::ClearFault).unwrap();
-        assert_eq!(s.mode(), Mode::Idle);
-    }
-
-    #[test]
-    fn stall_and_over_current_stop_after_their_debounce() {
-        let cfg = RigConfig::REFERENCE;
-        let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
-        s.request(Request::Start { omega: 300.0 }).unwrap();
-        // Crank at 10 % of the reference: stall after 300 ms, not before.
-        let mut t = 0;
-        for _ in 0..300 {
-            t += 1000;
-            s.heard_from_link(t);
-            s.check(t, &quiet(100.0, 10.0, false));
-            assert_eq!(s.mode(), Mode::Running, "t = {t}");
-        }
-        t += 1000;
-        assert!(s.check(t, &quiet(100.0, 10.0, false)).halt);
-        assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
-        s.request(Request::ClearFault).unwrap();
-        s.request(Request::Start { omega: 300.0 }).unwrap();
-        let mut inp = quiet(100.0, 100.0, false);
-        inp.current = Amps::from_num(5);
-        for _ in 0..20 {
-            t += 1000;
-            s.heard_from_link(t);
-            s.check(t, &inp);
-        }
-        assert_eq!(s.mode(), Mode::Running);
-        t += 1000;
-        s.check(t, &inp);
-        assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
     }
 }
