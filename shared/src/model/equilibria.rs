@@ -169,6 +169,12 @@ pub fn effective_potential(r: f64, theta_d: DriveAngle, phi: f64) -> f64 {
     -(math::cos(phi) + 0.25 * r * math::cos(2.0 * (phi - theta_d.rad())))
 }
 
+/// The energy of the averaged motion per I ω0²: E = φ'²/(2ω0²) + v(φ), conserved without damping
+/// (the averaged equation is φ'' = −ω0² v'(φ)).
+pub fn averaged_energy(r: f64, theta_d: DriveAngle, omega0: f64, phi: f64, rate: f64) -> f64 {
+    0.5 * rate * rate / (omega0 * omega0) + effective_potential(r, theta_d, phi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

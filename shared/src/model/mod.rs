@@ -1,17 +1,16 @@
-//! The pendulum model (SPEC §2–3).
+//! The pendulum model (SPEC §2–3). Its equations of motion — full, averaged, linearised, composed
+//! from a scene's effects — are in [`crate::sim::eom`].
 //!
 //! | module | concept |
 //! |---|---|
 //! | [`geometry`] | rod, point mass or general body → equivalent length ℓ |
 //! | [`drive`] | the shaking: amplitude A, angular frequency ω, drive angle θd |
 //! | [`groups`] | the dimensionless groups R, ωc, ω0, k, m, Q |
-//! | [`equations`] | the full and averaged equations of motion, the effective potential |
 //! | [`trig`] | degree-2 trigonometric polynomials and all their roots on the circle |
-//! | [`equilibria`] | every equilibrium of the averaged motion, with its stability |
+//! | [`equilibria`] | every equilibrium of the averaged motion, with its stability; the effective potential and energy |
 //! | [`infer`] | R inferred from a settled angle |
 
 pub mod drive;
-pub mod equations;
 pub mod equilibria;
 pub mod geometry;
 pub mod groups;
@@ -19,7 +18,6 @@ pub mod infer;
 pub mod trig;
 
 pub use drive::{Drive, DriveAngle};
-pub use equations::{AveragedModel, FullModel};
 pub use equilibria::{equilibria, Equilibria, Equilibrium, Stability};
 pub use geometry::Geometry;
 pub use groups::Groups;
