@@ -239,6 +239,21 @@ fn main() -> ! {
     });
     hprintln!("| sin+cos | f32, libm sincosf | {:.1} | {:.1e} |", i, e);
 
+    let e = trig_error(|a| {
+        let (s, c) = trig::sin_cos_cordic_model(a);
+        (s.to_num(), c.to_num())
+    });
+    let i = per_call(k, 20_000, |n| {
+        black_box(trig::sin_cos_cordic_model(Angle::from_bits(
+            (n as i32).wrapping_mul(214_013),
+        )));
+    });
+    hprintln!(
+        "| sin+cos | CORDIC algorithm in software (24 iterations, 24-bit; error model for the unit) | {:.1} | {:.1e} |",
+        i,
+        e
+    );
+
     // --- drive-waveform generator: phase + cos of the phase, per sample tick
     let mut dds = Dds::new(10_000, 62);
     dds.set_target(word_from_omega(313.0).unwrap_or(0));

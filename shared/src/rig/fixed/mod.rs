@@ -28,6 +28,7 @@
 //! | [`trig::sin_cos_table`] | 257-entry quarter-wave table, linear interpolation | 5e-6 |
 //! | [`trig::sin_cos_f32_poly`] | same reduction, Taylor to x⁷ / x⁸ in f32 | 4e-7 |
 //! | [`trig::sin_cos_f32_micromath`] | `micromath` (crude, for comparison only) | 2e-3 |
+//! | [`trig::sin_cos_cordic_model`] | software model of the G4's CORDIC: 24 iterations, 24-bit datapath (comparison only) | 2e-6 |
 //! | [`approx::ln_ratio`] | exponent by leading zeros, 2·atanh series to u⁷ | 1e-7 (abs.) |
 //! | [`approx::sqrt`] | `fixed`'s exact integer square root, truncating | 1 LSB |
 //! | [`approx::sqrt_micromath`] | bit trick, **crude** (√2 → 1.5); not used by the rig | 6 % rel. |

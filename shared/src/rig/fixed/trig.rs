@@ -216,6 +216,64 @@ pub fn sin_cos_f32_micromath(a: Angle) -> (f32, f32) {
     (micromath::F32(x).sin().0, micromath::F32(x).cos().0)
 }
 
+/// Gain compensation of the circular CORDIC, Π 1/√(1 + 2^-2i) over 24 iterations, in Q23.
+const CORDIC_K_Q23: i32 = 5_094_007; // round(0.607252935 · 2^23)
+
+/// atan(2^-i) in 2^-32 turn, i = 0..24: round(atan(2^-i)/(2π) · 2^32).
+const CORDIC_ATAN: [i32; 24] = {
+    let mut t = [0i32; 24];
+    let mut i = 0;
+    while i < 24 {
+        // atan(2^-i) by its Taylor series (|x| ≤ 1; at x = 1 use π/4 exactly)
+        let x = 1.0 / ((1u64 << i) as f64);
+        let a = if i == 0 {
+            core::f64::consts::FRAC_PI_4
+        } else {
+            let x2 = x * x;
+            let mut term = x;
+            let mut sum = x;
+            let mut n = 1;
+            while n < 30 {
+                term = -term * x2;
+                sum += term / ((2 * n + 1) as f64);
+                n += 1;
+            }
+            sum
+        };
+        t[i] = (a / core::f64::consts::TAU * 4_294_967_296.0 + 0.5) as i64 as i32;
+        i += 1;
+    }
+    t
+};
+
+/// (sin, cos) by a software model of a circular CORDIC with a 24-bit datapath and 24
+/// iterations — the STM32G4 CORDIC unit's algorithm at its q1.31 precision setting of 6
+/// (four iterations per clock). Used only to put an error on the unit in the cost table
+/// (`docs/accuracy-mcu.md`); the unit's own rounding may differ in the last bits.
+///
+/// ```text
+/// z₀ = r (|r| ≤ π/4 after the quadrant reduction), x₀ = K = Π 1/√(1 + 2^-2i), y₀ = 0
+/// dᵢ = sign zᵢ:  x ← x − dᵢ y 2^-i,  y ← y + dᵢ x 2^-i,  z ← z − dᵢ atan 2^-i     → (y, x) = (sin r, cos r)
+/// ```
+pub fn sin_cos_cordic_model(a: Angle) -> (Unit, Unit) {
+    let (q, r) = reduce(a);
+    let (mut x, mut y, mut z) = (CORDIC_K_Q23, 0i32, r);
+    for (i, &t) in CORDIC_ATAN.iter().enumerate() {
+        let (dx, dy) = (y >> i, x >> i);
+        if z >= 0 {
+            x -= dx;
+            y += dy;
+            z -= t;
+        } else {
+            x += dx;
+            y -= dy;
+            z += t;
+        }
+    }
+    let (s, c) = unfold(q, y << 7, x << 7); // Q23 → Q30
+    (Unit::from_bits(s), Unit::from_bits(c))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -280,6 +338,18 @@ mod tests {
             (f64::from(s), f64::from(c))
         });
         assert!(e <= 2e-3 && e > 1e-4, "max error {e:e}");
+    }
+
+    #[test]
+    fn cordic_model_bound() {
+        // 24 iterations leave a residual angle ≤ atan 2^-23 ≈ 1.2e-7 rad; the truncating shifts
+        // of the 24-bit datapath add up to ~24·2^-23 ≈ 3e-6 in the worst case: bound 2e-6
+        // (measured 1.35e-6 ≈ 2^-19.5).
+        let e = max_err(|a| {
+            let (s, c) = sin_cos_cordic_model(a);
+            (s.to_num(), c.to_num())
+        });
+        assert!(e <= 2e-6 && e > 1e-7, "max error {e:e}");
     }
 
     #[test]
