@@ -8,8 +8,9 @@
 //! motor (first-order speed lag, gain error, back-EMF current):
 //!   ψ' = ω_m,   ω_m' = (g_err·ω_full·duty − ω_m)/τ_m,   I = (V·duty − k_e ω_m)/R_a
 //! ```
-//! With ψ = ωt (constant speed) the pendulum equation is exactly `kapitza_core::model::FullModel`
-//! — `plant_matches_full_model` checks it. The pivot follows the motor, not the reference, so the
+//! With ψ = ωt (constant speed) the pendulum equation is exactly SPEC §3's full equation
+//! θ'' = −ω0² sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − cθ' — `closed_loop_safety.rs`'s
+//! `plant_matches_the_full_equation` checks it. The pivot follows the motor, not the reference, so the
 //! phase lock matters. Sensors: the pendulum encoder quantises to 14 bits after Gaussian noise
 //! (xorshift64* + Box–Muller, seeded); the crank encoder to 4096 counts per turn.
 
