@@ -179,7 +179,7 @@ mod tests {
         for _ in 0..100_000 {
             x = x.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
             let num = (x >> 12) as i64 - (1 << 51);
-            let den = ((x & 0xFFFF_FFF) as i64 - (1 << 27)) | 1;
+            let den = ((x & 0x0FFF_FFFF) as i64 - (1 << 27)) | 1;
             let err = (div_round(num, den) as f64 - num as f64 / den as f64).abs();
             assert!(err <= 0.5 + 1e-6, "{num}/{den}: {err}");
         }
