@@ -29,8 +29,6 @@ fn request() -> impl Strategy<Value = Request> {
         Just(Request::Stop),
         Just(Request::ClearFault),
         Just(Request::Start { omega: f64::NAN }),
-        (-1.0f64..8.0).prop_map(|r| Request::StartR { r }),
-        (-1.0f64..8.0).prop_map(|r| Request::SetR { r }),
     ]
 }
 
@@ -256,31 +254,4 @@ fn stall_and_over_current_stop_after_their_debounce() {
     t += 1000;
     s.check(t, &inp);
     assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
-}
-
-#[test]
-fn r_requests_compute_omega_from_the_rig() {
-    // ω = ωc√R with ωc = √(2gℓ)/A = 180.83 rad/s for the reference rig (SPEC §3): R = 3 gives
-    // 313.2 rad/s; R = 6 needs 442.9 rad/s, above the 420 rad/s limit, and is refused with the
-    // ω it would need.
-    let cfg = RigConfig::REFERENCE;
-    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
-    let before = s;
-    match s.request(Request::StartR { r: 6.0 }) {
-        Err(Refusal::OmegaAboveLimit { requested, limit }) => {
-            assert!((requested - cfg.omega_for_r(6.0).unwrap()).abs() < 1e-9);
-            assert_eq!(limit, 420.0);
-        }
-        other => panic!("{other:?}"),
-    }
-    assert_eq!(
-        s.request(Request::StartR { r: -1.0 }),
-        Err(Refusal::RInvalid { requested: -1.0 })
-    );
-    assert_eq!(s, before);
-    s.request(Request::StartR { r: 3.0 }).unwrap();
-    assert_eq!(
-        s.target_word(),
-        word_from_omega(cfg.omega_for_r(3.0).unwrap()).unwrap()
-    );
 }

@@ -14,8 +14,7 @@
 //!    └──────────── Faulted ◀─────────┴── e-stop, over-current, stall (from any state): drive
 //!                                        halted at once, duty 0, latched
 //! ```
-//! R requests (`StartR`, `SetR`) become ω = ωc√R with the configured stroke and pendulum, then
-//! pass the same checks. Limits: ω ≤ ω_max (refused above); |dω/dt| ≤ the ramp rate (the drive generator's step, not
+//! Limits: ω ≤ ω_max (refused above); |dω/dt| ≤ the ramp rate (the drive generator's step, not
 //! a request); |dθd/dt| ≤ its limit (slewed here); θd inside the mount's travel (refused
 //! outside). Over-current: I > I_max for `overcurrent_ms`. Stall: commanded ω ≥ `stall_min_omega`
 //! and crank speed < `stall_fraction`·commanded for `stall_ms`.
@@ -41,11 +40,6 @@ pub enum Request {
     Start { omega: f64 },
     /// New ω while `Running`; ramped.
     SetOmega { omega: f64 },
-    /// Soft start to drive strength R: ω = ωc√R with ωc = √(2gℓ)/A of the configured stroke and
-    /// pendulum (SPEC §7, "setting R means computing ω from R, A and ℓ"); then as `Start`.
-    StartR { r: f64 },
-    /// New R while `Running`; as `SetOmega`.
-    SetR { r: f64 },
     /// New drive angle θd (degrees); slewed.
     SetDriveAngle { deg: f64 },
     /// Soft stop.
@@ -59,10 +53,6 @@ pub enum Request {
 pub enum Refusal {
     /// Not a finite number ≥ 0.
     OmegaInvalid {
-        requested: f64,
-    },
-    /// R not a finite number ≥ 0.
-    RInvalid {
         requested: f64,
     },
     OmegaAboveLimit {
@@ -87,9 +77,6 @@ impl core::fmt::Display for Refusal {
         match *self {
             Self::OmegaInvalid { requested } => {
                 write!(f, "omega = {requested} is not a finite number >= 0")
-            }
-            Self::RInvalid { requested } => {
-                write!(f, "R = {requested} is not a finite number >= 0")
             }
             Self::OmegaAboveLimit { requested, limit } => {
                 write!(
@@ -187,8 +174,6 @@ pub struct Supervisor {
     stall_frac_q16: i64,
     stall_us: u32,
     link_us: u32,
-    /// ωc = √(2gℓ)/A (rad/s): ω = ωc√R.
-    omega_c: f64,
 }
 
 impl Supervisor {
@@ -220,7 +205,6 @@ impl Supervisor {
             stall_frac_q16: libm::round(l.stall_fraction * 65_536.0) as i64,
             stall_us: l.stall_ms.saturating_mul(1000),
             link_us: l.link_timeout_ms.saturating_mul(1000),
-            omega_c: libm::sqrt(2.0 * cfg.gravity * cfg.ell()) / cfg.amplitude,
         }
     }
 
@@ -245,13 +229,6 @@ impl Supervisor {
         self.last_link_us = now_us;
     }
 
-    fn omega_for_r(&self, r: f64) -> Result<f64, Refusal> {
-        if !r.is_finite() || r < 0.0 {
-            return Err(Refusal::RInvalid { requested: r });
-        }
-        Ok(self.omega_c * libm::sqrt(r))
-    }
-
     fn check_omega(&self, omega: f64) -> Result<u32, Refusal> {
         if !omega.is_finite() || omega < 0.0 {
             return Err(Refusal::OmegaInvalid { requested: omega });
@@ -272,15 +249,6 @@ impl Supervisor {
                 return Err(Refusal::Faulted(f));
             }
         }
-        let req = match req {
-            Request::StartR { r } => Request::Start {
-                omega: self.omega_for_r(r)?,
-            },
-            Request::SetR { r } => Request::SetOmega {
-                omega: self.omega_for_r(r)?,
-            },
-            other => other,
-        };
         match req {
             Request::Start { omega } => {
                 let w = self.check_omega(omega)?;
@@ -308,7 +276,6 @@ impl Supervisor {
                 }
                 self.theta_target = Angle::from_deg(deg);
             }
-            Request::StartR { .. } | Request::SetR { .. } => unreachable!("converted above"),
             Request::Stop => {
                 if self.mode == Mode::Running {
                     self.mode = Mode::Stopping(StopReason::Requested);
