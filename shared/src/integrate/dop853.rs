@@ -268,7 +268,11 @@ impl Dop853 {
                 return Ok(Solution { t, y, stats });
             }
 
-            let memory = if self.beta == 0.0 { 1.0 } else { math::powf(err_prev, self.beta) };
+            let memory = if self.beta == 0.0 {
+                1.0
+            } else {
+                math::powf(err_prev, self.beta)
+            };
             let fac = (fac_err / memory / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
             let mut h_new = (h.abs() / fac).min(h_max);
             if after_reject {
