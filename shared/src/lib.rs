@@ -14,6 +14,8 @@
 //! | [`sim`] | the simulator: scenes, composed equations of motion, runs and outcomes |
 //! | [`real`] | the number formats (f64, f32) behind one trait, math through libm |
 //! | [`rig`] | the microcontroller's logic: drive generator, phase lock, fixed-point estimator, safety — tested on the host and on an emulated Cortex-M4 |
+//! | [`link`] | the serial link: typed messages, COBS + CRC-32C frames, protocol version and compatibility policy, refusal reasons, the rig's side of the conversation |
+//! | [`persist`] | the rig configuration as a checksummed flash record, with the fallback to safe defaults |
 //! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
 //!
 //! # Conventions (SPEC §2–3)
@@ -33,8 +35,10 @@ extern crate std;
 pub mod cases;
 pub mod error;
 pub mod integrate;
+pub mod link;
 pub mod math;
 pub mod model;
+pub mod persist;
 pub mod poly;
 pub mod real;
 pub mod rig;

@@ -1,0 +1,244 @@
+//! Between the rig's types and their wire images: modes, faults, refusals, the configuration,
+//! and the I16F16 / degree conversions at the boundary.
+
+use super::message::{Fault, Mode, RMethod, StopReason, WireConfig, WireGeometry, Q16};
+use super::reason::{ConfigField, Reason};
+use crate::model::{self, Geometry};
+use crate::rig::config::{Limits, MotorConfig, RigConfig};
+use crate::rig::fixed::Angle;
+use crate::rig::safety;
+use crate::ParamError;
+
+/// A number as I16F16 bits, saturating at the ends of the range; NaN gives 0.
+pub fn to_q16(x: f64) -> Q16 {
+    if x.is_nan() {
+        0
+    } else {
+        libm::round(x * 65_536.0).clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32
+    }
+}
+
+/// I16F16 bits as a number (exact).
+pub fn from_q16(bits: Q16) -> f64 {
+    f64::from(bits) / 65_536.0
+}
+
+/// θd in degrees along the mount's travel: the wrapping angle unwrapped upwards from the
+/// travel's lower end `min_deg` (so a θd inside the travel comes out as the number it was set
+/// as, 190° as 190°, not −170°).
+pub fn deg_along_travel(theta: Angle, min_deg: f64) -> f64 {
+    let off = (theta - Angle::from_deg(min_deg)).to_turns_u32();
+    min_deg + f64::from(off) * (360.0 / 4_294_967_296.0)
+}
+
+impl From<safety::Fault> for Fault {
+    fn from(f: safety::Fault) -> Self {
+        match f {
+            safety::Fault::EStop => Self::EStop,
+            safety::Fault::OverCurrent => Self::OverCurrent,
+            safety::Fault::Stall => Self::Stall,
+        }
+    }
+}
+
+impl From<safety::StopReason> for StopReason {
+    fn from(r: safety::StopReason) -> Self {
+        match r {
+            safety::StopReason::Requested => Self::Requested,
+            safety::StopReason::LinkSilent => Self::LinkSilent,
+            safety::StopReason::Fault(f) => Self::Fault(f.into()),
+        }
+    }
+}
+
+impl From<safety::Mode> for Mode {
+    fn from(m: safety::Mode) -> Self {
+        match m {
+            safety::Mode::Idle => Self::Idle,
+            safety::Mode::Running => Self::Running,
+            safety::Mode::Stopping(r) => Self::Stopping(r.into()),
+            safety::Mode::Faulted(f) => Self::Faulted(f.into()),
+        }
+    }
+}
+
+impl From<model::RMethod> for RMethod {
+    fn from(m: model::RMethod) -> Self {
+        match m {
+            model::RMethod::EquilibriumAngle => Self::EquilibriumAngle,
+            model::RMethod::SlowFrequency => Self::SlowFrequency,
+        }
+    }
+}
+
+impl From<safety::Refusal> for Reason {
+    fn from(r: safety::Refusal) -> Self {
+        use safety::Refusal as R;
+        match r {
+            R::OmegaInvalid { .. } => Self::OmegaInvalid,
+            R::OmegaAboveLimit { requested, limit } => Self::OmegaAboveLimit {
+                requested: to_q16(requested),
+                limit: to_q16(limit),
+            },
+            R::DriveAngleOutOfRange {
+                requested,
+                min,
+                max,
+            } => Self::DriveAngleOutOfRange {
+                requested: to_q16(requested),
+                min: to_q16(min),
+                max: to_q16(max),
+            },
+            R::Faulted(f) => Self::Faulted(f.into()),
+            R::WrongMode(m) => Self::WrongMode(m.into()),
+            R::EStopStillActive => Self::EStopStillActive,
+        }
+    }
+}
+
+impl From<ParamError> for Reason {
+    fn from(e: ParamError) -> Self {
+        Self::ConfigInvalid {
+            field: ConfigField::from_param_name(e.name),
+        }
+    }
+}
+
+impl From<Geometry> for WireGeometry {
+    fn from(g: Geometry) -> Self {
+        match g {
+            Geometry::Rod { length } => Self::Rod { length },
+            Geometry::PointMass { length } => Self::PointMass { length },
+            Geometry::General { inertia, mass, com } => Self::General { inertia, mass, com },
+        }
+    }
+}
+
+impl From<WireGeometry> for Geometry {
+    fn from(g: WireGeometry) -> Self {
+        match g {
+            WireGeometry::Rod { length } => Self::Rod { length },
+            WireGeometry::PointMass { length } => Self::PointMass { length },
+            WireGeometry::General { inertia, mass, com } => Self::General { inertia, mass, com },
+        }
+    }
+}
+
+impl From<RigConfig> for WireConfig {
+    fn from(c: RigConfig) -> Self {
+        let RigConfig {
+            amplitude,
+            geometry,
+            gravity,
+            limits:
+                Limits {
+                    omega_max,
+                    omega_rate_max,
+                    drive_angle_min_deg,
+                    drive_angle_max_deg,
+                    drive_angle_rate_max_deg,
+                    current_max,
+                    overcurrent_ms,
+                    stall_min_omega,
+                    stall_fraction,
+                    stall_ms,
+                    link_timeout_ms,
+                },
+            motor:
+                MotorConfig {
+                    omega_per_duty,
+                    lag,
+                    kp,
+                    ki,
+                    max_correction,
+                },
+            sample_hz,
+            control_hz,
+        } = c;
+        Self {
+            amplitude,
+            geometry: geometry.into(),
+            gravity,
+            omega_max,
+            omega_rate_max,
+            drive_angle_min_deg,
+            drive_angle_max_deg,
+            drive_angle_rate_max_deg,
+            current_max,
+            overcurrent_ms,
+            stall_min_omega,
+            stall_fraction,
+            stall_ms,
+            link_timeout_ms,
+            omega_per_duty,
+            lag,
+            kp,
+            ki,
+            max_correction,
+            sample_hz,
+            control_hz,
+        }
+    }
+}
+
+impl From<WireConfig> for RigConfig {
+    fn from(w: WireConfig) -> Self {
+        let WireConfig {
+            amplitude,
+            geometry,
+            gravity,
+            omega_max,
+            omega_rate_max,
+            drive_angle_min_deg,
+            drive_angle_max_deg,
+            drive_angle_rate_max_deg,
+            current_max,
+            overcurrent_ms,
+            stall_min_omega,
+            stall_fraction,
+            stall_ms,
+            link_timeout_ms,
+            omega_per_duty,
+            lag,
+            kp,
+            ki,
+            max_correction,
+            sample_hz,
+            control_hz,
+        } = w;
+        Self {
+            amplitude,
+            geometry: geometry.into(),
+            gravity,
+            limits: Limits {
+                omega_max,
+                omega_rate_max,
+                drive_angle_min_deg,
+                drive_angle_max_deg,
+                drive_angle_rate_max_deg,
+                current_max,
+                overcurrent_ms,
+                stall_min_omega,
+                stall_fraction,
+                stall_ms,
+                link_timeout_ms,
+            },
+            motor: MotorConfig {
+                omega_per_duty,
+                lag,
+                kp,
+                ki,
+                max_correction,
+            },
+            sample_hz,
+            control_hz,
+        }
+    }
+}
+
+impl WireConfig {
+    /// The configuration this describes, if [`RigConfig::validate`] accepts it.
+    pub fn to_valid(self) -> Result<RigConfig, Reason> {
+        RigConfig::from(self).validate().map_err(Reason::from)
+    }
+}

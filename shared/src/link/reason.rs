@@ -1,0 +1,207 @@
+//! Why something was refused: one [`Reason`] for every way a request can fail, each with a
+//! stable numeric code and a sentence the host can show.
+//!
+//! Two kinds, kept apart by [`Reason::is_link`]:
+//!
+//! ```text
+//! code     kind      meaning                                               the host should
+//! 1..=15   link      the frame did not arrive as sent, or speaks another    resend / check versions
+//!                    protocol version; the rig did not look at the command
+//! 16..     command   the rig understood and refused (limits, mode, fault)   show it to the user
+//! ```
+//! Codes never change meaning within a protocol version; a new reason gets a new code.
+
+use core::fmt;
+
+use postcard::experimental::max_size::MaxSize;
+use serde::{Deserialize, Serialize};
+
+use super::message::{Fault, Mode, Q16};
+
+/// A refusal: the frame was bad or the command was not allowed. Nothing changed on the rig.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Reason {
+    // --- link level: the line failed ---
+    /// The CRC did not match: noise or a lost byte.
+    BadCrc,
+    /// The frame ended before its header, CRC or message was complete.
+    Truncated,
+    /// Not a valid encoding (bad COBS, varint, bool or option tag, or bytes left over).
+    Malformed,
+    /// A message kind this rig does not know (a newer host?).
+    UnknownMessage,
+    /// The frame's protocol version is not the rig's; only `GetVersion` is answered.
+    VersionMismatch { rig: u8, frame: u8 },
+    /// Longer than the largest frame of this protocol version.
+    TooLong,
+    /// The rig could not take the command now (its queue was full); send it again.
+    Busy,
+
+    // --- command level: the rig refused ---
+    /// R is negative or not a number.
+    RInvalid { requested: Q16 },
+    /// ω is not a finite number ≥ 0.
+    OmegaInvalid,
+    /// ω = ωc √R (rad/s, I16F16) is above the limit ω_max.
+    OmegaAboveLimit { requested: Q16, limit: Q16 },
+    /// θd (degrees, I16F16) is outside the mount's travel [min, max].
+    DriveAngleOutOfRange { requested: Q16, min: Q16, max: Q16 },
+    /// A fault is latched: clear it first.
+    Faulted(Fault),
+    /// Not allowed in the current mode (start needs idle, a new ω needs running, a new
+    /// configuration needs idle).
+    WrongMode(Mode),
+    /// `ClearFault` while the e-stop is still pressed.
+    EStopStillActive,
+    /// A configuration value is out of range.
+    ConfigInvalid { field: ConfigField },
+}
+
+/// The configuration field a [`Reason::ConfigInvalid`] names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigField {
+    Amplitude,
+    Geometry,
+    Gravity,
+    OmegaMax,
+    OmegaRateMax,
+    DriveAngleRange,
+    DriveAngleRateMax,
+    CurrentMax,
+    StallMinOmega,
+    StallFraction,
+    OmegaPerDuty,
+    Lag,
+    Kp,
+    Ki,
+    MaxCorrection,
+    Rates,
+    Other,
+}
+
+impl ConfigField {
+    /// The field a [`crate::ParamError`] from `RigConfig::validate` names.
+    pub fn from_param_name(name: &str) -> Self {
+        match name {
+            "amplitude" => Self::Amplitude,
+            "gravity" => Self::Gravity,
+            "equivalent length" | "length" | "inertia" | "mass" | "com" => Self::Geometry,
+            "omega_max" => Self::OmegaMax,
+            "omega_rate_max" => Self::OmegaRateMax,
+            "drive_angle_min_deg" | "drive_angle_max_deg" => Self::DriveAngleRange,
+            "drive_angle_rate_max_deg" => Self::DriveAngleRateMax,
+            "current_max" => Self::CurrentMax,
+            "stall_min_omega" => Self::StallMinOmega,
+            "stall_fraction" => Self::StallFraction,
+            "omega_per_duty" => Self::OmegaPerDuty,
+            "lag" => Self::Lag,
+            "kp" => Self::Kp,
+            "ki" => Self::Ki,
+            "max_correction" => Self::MaxCorrection,
+            "sample_hz" | "control_hz" => Self::Rates,
+            _ => Self::Other,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Amplitude => "amplitude",
+            Self::Geometry => "geometry",
+            Self::Gravity => "gravity",
+            Self::OmegaMax => "omega_max",
+            Self::OmegaRateMax => "omega_rate_max",
+            Self::DriveAngleRange => "drive_angle_min_deg/drive_angle_max_deg",
+            Self::DriveAngleRateMax => "drive_angle_rate_max_deg",
+            Self::CurrentMax => "current_max",
+            Self::StallMinOmega => "stall_min_omega",
+            Self::StallFraction => "stall_fraction",
+            Self::OmegaPerDuty => "omega_per_duty",
+            Self::Lag => "lag",
+            Self::Kp => "kp",
+            Self::Ki => "ki",
+            Self::MaxCorrection => "max_correction",
+            Self::Rates => "sample_hz/control_hz",
+            Self::Other => "a configuration value",
+        }
+    }
+}
+
+impl Reason {
+    /// The stable numeric code (1–15 link level, 16 and up command level).
+    pub fn code(&self) -> u8 {
+        match self {
+            Self::BadCrc => 1,
+            Self::Truncated => 2,
+            Self::Malformed => 3,
+            Self::UnknownMessage => 4,
+            Self::VersionMismatch { .. } => 5,
+            Self::TooLong => 6,
+            Self::Busy => 7,
+            Self::RInvalid { .. } => 16,
+            Self::OmegaInvalid => 17,
+            Self::OmegaAboveLimit { .. } => 18,
+            Self::DriveAngleOutOfRange { .. } => 19,
+            Self::Faulted(_) => 20,
+            Self::WrongMode(_) => 21,
+            Self::EStopStillActive => 22,
+            Self::ConfigInvalid { .. } => 23,
+        }
+    }
+
+    /// The line failed (resend, or check versions), as opposed to the rig refusing a command.
+    pub fn is_link(&self) -> bool {
+        self.code() < 16
+    }
+}
+
+/// I16F16 bits as a number, for messages.
+fn q16(bits: Q16) -> f64 {
+    f64::from(bits) / 65_536.0
+}
+
+impl fmt::Display for Reason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "[{}] ", self.code())?;
+        match *self {
+            Self::BadCrc => f.write_str("frame damaged on the line (CRC mismatch)"),
+            Self::Truncated => f.write_str("frame cut short"),
+            Self::Malformed => f.write_str("frame not validly encoded"),
+            Self::UnknownMessage => f.write_str("message kind unknown to this rig"),
+            Self::VersionMismatch { rig, frame } => write!(
+                f,
+                "protocol version {frame} in the frame, but the rig speaks version {rig}"
+            ),
+            Self::TooLong => f.write_str("frame longer than any message of this protocol"),
+            Self::Busy => f.write_str("rig busy, command not taken; send it again"),
+            Self::RInvalid { requested } => {
+                write!(f, "R = {} is not a number >= 0", q16(requested))
+            }
+            Self::OmegaInvalid => f.write_str("the drive frequency is not a number >= 0"),
+            Self::OmegaAboveLimit { requested, limit } => write!(
+                f,
+                "omega = {} rad/s is above the limit {} rad/s",
+                q16(requested),
+                q16(limit)
+            ),
+            Self::DriveAngleOutOfRange {
+                requested,
+                min,
+                max,
+            } => write!(
+                f,
+                "drive angle {} deg is outside the mount's travel [{}, {}] deg",
+                q16(requested),
+                q16(min),
+                q16(max)
+            ),
+            Self::Faulted(x) => write!(f, "fault latched ({x:?}): clear it first"),
+            Self::WrongMode(m) => write!(f, "not allowed in mode {m:?}"),
+            Self::EStopStillActive => f.write_str("the emergency stop is still pressed"),
+            Self::ConfigInvalid { field } => {
+                write!(f, "configuration value {} out of range", field.name())
+            }
+        }
+    }
+}
