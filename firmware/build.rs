@@ -16,6 +16,10 @@ fn main() {
     let memory_x = manifest_dir.join("..").join("memory.x");
     fs::copy(&memory_x, out_dir.join("memory.x"))
         .unwrap_or_else(|e| panic!("cannot copy {}: {e}", memory_x.display()));
+    // The flash page reserved for the configuration record, checked at link time.
+    let persist_x = manifest_dir.join("persist.x");
+    fs::copy(&persist_x, out_dir.join("persist.x"))
+        .unwrap_or_else(|e| panic!("cannot copy {}: {e}", persist_x.display()));
     println!("cargo:rustc-link-search={}", out_dir.display());
 
     // --nmagic: do not page-align sections, so the flash image is not padded.
@@ -24,7 +28,10 @@ fn main() {
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
     // defmt's linker script: the interned log strings.
     println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+    // The program image must stay below the configuration page.
+    println!("cargo:rustc-link-arg-bins=-Tpersist.x");
 
     println!("cargo:rerun-if-changed=../memory.x");
+    println!("cargo:rerun-if-changed=persist.x");
     println!("cargo:rerun-if-changed=build.rs");
 }
