@@ -156,7 +156,7 @@ fn status() -> impl Strategy<Value = Status> {
     (
         (mode(), proptest::option::of(stop_reason()), any::<bool>()),
         (any::<i32>(), any::<i32>(), any::<i32>(), any::<i32>()),
-        (origin(), any::<u32>(), any::<[u32; 5]>()),
+        (origin(), any::<u32>(), any::<[u32; 4]>()),
     )
         .prop_map(|(a, b, c)| Status {
             mode: a.0,
@@ -173,7 +173,6 @@ fn status() -> impl Strategy<Value = Status> {
                 frames_bad: c.2[1],
                 sensor_errors: c.2[2],
                 overruns: c.2[3],
-                telemetry_dropped: c.2[4],
             },
         })
 }

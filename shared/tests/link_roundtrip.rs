@@ -120,7 +120,6 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
     s.counters.frames_bad = u32::MAX;
     s.counters.sensor_errors = u32::MAX;
     s.counters.overruns = u32::MAX;
-    s.counters.telemetry_dropped = u32::MAX;
     vec![
         (
             "set_config",

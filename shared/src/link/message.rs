@@ -131,10 +131,8 @@ pub struct Counters {
     pub frames_bad: u32,
     /// Pendulum-sensor reads that failed (the last good angle was used).
     pub sensor_errors: u32,
-    /// Sample ticks the control loop ran late for.
+    /// Pendulum samples taken more than half a period late.
     pub overruns: u32,
-    /// Telemetry frames dropped because the line was busy.
-    pub telemetry_dropped: u32,
 }
 
 /// One snapshot of the control loop and the estimator.

@@ -36,7 +36,6 @@ pub fn status() -> Status {
             frames_bad: 3,
             sensor_errors: 0,
             overruns: 1,
-            telemetry_dropped: 7,
         },
     }
 }
