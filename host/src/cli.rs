@@ -21,6 +21,7 @@ pub enum Command {
     Predict(cmd::predict::Args),
     Boundary(cmd::boundary::Args),
     Simulate(cmd::simulate::Args),
+    Bench(cmd::bench::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -76,6 +77,7 @@ where
         Command::Predict(a) => cmd::predict::run(&a, out)?,
         Command::Boundary(a) => cmd::boundary::run(&a, out)?,
         Command::Simulate(a) => cmd::simulate::run(&a, out)?,
+        Command::Bench(a) => cmd::bench::run(&a, out)?,
     }
     Ok(())
 }

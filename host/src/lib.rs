@@ -4,6 +4,7 @@
 //!
 //! | module | concept |
 //! |---|---|
+//! | [`bench`] | `kapitza bench`: work-precision, the peer, the stability ladder, the physical question |
 //! | [`cli`] | parsing, dispatch, and the error type that picks the exit status |
 //! | [`input`] | checks of command-line numbers |
 //! | [`scene_file`] | scene files (TOML) and `--set` → the core's `Scene`, run options, `[expect]` |
@@ -13,6 +14,7 @@
 //! | [`plot`] | PNG plots with a bundled font |
 //! | [`timing`] | measured cost of a function |
 
+pub mod bench;
 pub mod cli;
 pub mod cmd;
 pub mod csv_out;
