@@ -136,6 +136,7 @@ fn json_has_the_documented_keys() {
         "setting",
         "error",
         "wall_s",
+        "cpu_s",
         "rhs_evals",
         "steps",
         "rejected",
@@ -164,7 +165,7 @@ fn peer_ratios_present_for_every_scene_and_target() {
                 .iter()
                 .find(|r| r["scene"] == scene && num(&r["target_error"]) == target)
                 .unwrap_or_else(|| panic!("no peer ratio for {scene} at {target:e}"));
-            for key in ["time_ratio", "evals_ratio"] {
+            for key in ["time_ratio", "evals_ratio", "cpu_ratio"] {
                 let x = num(&r[key]);
                 assert!(x.is_finite() && x > 0.0, "{scene} {target:e} {key} = {x}");
             }

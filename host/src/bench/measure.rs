@@ -13,8 +13,8 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 use std::time::Duration;
 
+use super::clock;
 use super::scenes::BenchScene;
-use crate::timing::seconds_per_eval;
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::sim::sampling::Discard;
@@ -167,6 +167,8 @@ pub struct Point {
     pub error: f64,
     /// Median wall time of one run (s).
     pub wall_s: f64,
+    /// Median CPU time of this thread for one run (s): see [`clock`].
+    pub cpu_s: f64,
     pub rhs_evals: u64,
     pub steps: u64,
     pub rejected: u64,
@@ -261,7 +263,7 @@ pub fn ours(job: &Job, batch: Duration) -> Result<Point> {
     if !err.is_finite() {
         return Err(anyhow!("the end state is not finite"));
     }
-    let wall_s = seconds_per_eval(batch, || run(&scene, method, job.format));
+    let cost = clock::cost(batch, || run(&scene, method, job.format));
     Ok(Point {
         scene: job.scene.name.to_string(),
         family: job.family,
@@ -275,7 +277,8 @@ pub fn ours(job: &Job, batch: Duration) -> Result<Point> {
         setting_name: job.family.setting_name(),
         setting: job.setting,
         error: err,
-        wall_s,
+        wall_s: cost.wall_s,
+        cpu_s: cost.cpu_s,
         rhs_evals: r.work.rhs_evals,
         steps: r.work.steps,
         rejected: r.work.rejected,

@@ -31,6 +31,7 @@ use ode_solvers::{Dop853, Dopri5, OutputType, Vector2, Vector3};
 use std::cell::Cell;
 use std::time::Duration;
 
+use super::clock;
 use super::measure::{error, Family, Point, Reference};
 use super::scenes::BenchScene;
 use crate::timing::seconds_per_eval;
@@ -268,7 +269,7 @@ pub fn peer(
             r.evals_reported
         ));
     }
-    let wall_s = seconds_per_eval(batch, || run_with(family, &s.scene, &NoTally, tol));
+    let cost = clock::cost(batch, || run_with(family, &s.scene, &NoTally, tol));
     Ok(Point {
         scene: s.name.to_string(),
         family,
@@ -278,7 +279,8 @@ pub fn peer(
         setting_name: "rtol",
         setting: tol,
         error: err,
-        wall_s,
+        wall_s: cost.wall_s,
+        cpu_s: cost.cpu_s,
         rhs_evals: evals,
         steps: r.steps,
         rejected: r.rejected,

@@ -22,13 +22,17 @@ use super::measure::{Family, Point};
 /// What a cost is measured in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Cost {
+    /// Median wall time.
     Time,
+    /// Median CPU time of the measuring thread.
+    Cpu,
     Evals,
 }
 
 fn cost(p: &Point, c: Cost) -> f64 {
     match c {
         Cost::Time => p.wall_s,
+        Cost::Cpu => p.cpu_s,
         Cost::Evals => p.rhs_evals as f64,
     }
 }
@@ -117,10 +121,14 @@ pub struct PeerRatio {
     pub time_ratio: Option<f64>,
     /// The same for evaluations.
     pub evals_ratio: Option<f64>,
+    /// The same for the measuring thread's CPU time (steadier than wall time on a busy machine).
+    pub cpu_ratio: Option<f64>,
     pub ours_time: Option<AtTarget>,
     pub peer_time: Option<AtTarget>,
     pub ours_evals: Option<AtTarget>,
     pub peer_evals: Option<AtTarget>,
+    pub ours_cpu: Option<AtTarget>,
+    pub peer_cpu: Option<AtTarget>,
     /// Beside the ratio, not in it: the averaged model's cost when it reaches the target (its
     /// error against the full model's reference is the model error).
     pub averaged_time: Option<AtTarget>,
@@ -135,6 +143,8 @@ pub fn peer_ratio(points: &[Point], scene: &str, target: f64, workaround: bool) 
     let peer_time = best(points, scene, target, Cost::Time, peer);
     let ours_evals = best(points, scene, target, Cost::Evals, ours);
     let peer_evals = best(points, scene, target, Cost::Evals, peer);
+    let ours_cpu = best(points, scene, target, Cost::Cpu, ours);
+    let peer_cpu = best(points, scene, target, Cost::Cpu, peer);
     let ratio = |a: &Option<AtTarget>, b: &Option<AtTarget>| {
         a.as_ref().zip(b.as_ref()).map(|(a, b)| a.cost / b.cost)
     };
@@ -143,11 +153,14 @@ pub fn peer_ratio(points: &[Point], scene: &str, target: f64, workaround: bool) 
         target_error: target,
         time_ratio: ratio(&ours_time, &peer_time),
         evals_ratio: ratio(&ours_evals, &peer_evals),
+        cpu_ratio: ratio(&ours_cpu, &peer_cpu),
         averaged_time: best(points, scene, target, Cost::Time, |f| !f.is_full_model()),
         ours_time,
         peer_time,
         ours_evals,
         peer_evals,
+        ours_cpu,
+        peer_cpu,
     }
 }
 
@@ -166,6 +179,7 @@ mod tests {
             setting: 1.0,
             error,
             wall_s,
+            cpu_s: wall_s,
             rhs_evals: evals,
             steps: evals / 4,
             rejected: 0,

@@ -44,12 +44,12 @@ pub fn csv(r: &Results, dir: &Path) -> Result<Vec<String>> {
     };
 
     let mut t = String::from(
-        "scene,family,who,fidelity,format,setting_name,setting,error,wall_s,rhs_evals,steps,rejected\n",
+        "scene,family,who,fidelity,format,setting_name,setting,error,wall_s,cpu_s,rhs_evals,steps,rejected\n",
     );
     for p in &r.measurements {
         let _ = writeln!(
             t,
-            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             p.scene,
             p.family.name(),
             p.who,
@@ -59,6 +59,7 @@ pub fn csv(r: &Results, dir: &Path) -> Result<Vec<String>> {
             num(p.setting),
             num(p.error),
             num(p.wall_s),
+            num(p.cpu_s),
             p.rhs_evals,
             p.steps,
             p.rejected
@@ -67,7 +68,7 @@ pub fn csv(r: &Results, dir: &Path) -> Result<Vec<String>> {
     put("measurements.csv", t)?;
 
     let mut t = String::from(
-        "scene,target_error,time_ratio,evals_ratio,ours_time_method,ours_time_s,peer_time_method,peer_time_s,ours_evals_method,ours_evals,peer_evals_method,peer_evals,averaged_time_s\n",
+        "scene,target_error,time_ratio,evals_ratio,cpu_ratio,ours_time_method,ours_time_s,peer_time_method,peer_time_s,ours_evals_method,ours_evals,peer_evals_method,peer_evals,averaged_time_s\n",
     );
     let m = |a: &Option<AtTarget>| {
         a.as_ref().map_or((String::new(), String::new()), |a| {
@@ -81,11 +82,12 @@ pub fn csv(r: &Results, dir: &Path) -> Result<Vec<String>> {
         let (pe, pec) = m(&p.peer_evals);
         let _ = writeln!(
             t,
-            "{},{},{},{},{ot},{otc},{pt},{ptc},{oe},{oec},{pe},{pec},{}",
+            "{},{},{},{},{},{ot},{otc},{pt},{ptc},{oe},{oec},{pe},{pec},{}",
             p.scene,
             num(p.target_error),
             opt(p.time_ratio),
             opt(p.evals_ratio),
+            opt(p.cpu_ratio),
             opt(p.averaged_time.as_ref().map(|a| a.cost))
         );
     }
@@ -255,17 +257,18 @@ pub fn peer_table(rows: &[PeerRatio]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| scene | target error | time ratio | evaluations ratio | our best by time | peer's best by time | our best by evaluations | peer's best by evaluations | averaged model (beside, by time) |"
+        "| scene | target error | time ratio | evaluations ratio | CPU-time ratio | our best by time | peer's best by time | our best by evaluations | peer's best by evaluations | averaged model (beside, by time) |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     for p in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             p.scene,
             sci(p.target_error),
             ratio(p.time_ratio),
             ratio(p.evals_ratio),
+            ratio(p.cpu_ratio),
             at(&p.ours_time, true),
             at(&p.peer_time, true),
             at(&p.ours_evals, false),
@@ -393,22 +396,23 @@ pub fn markdown(r: &Results, command: &str) -> String {
         let _ = writeln!(s, "### {}\n", c.name);
         let _ = writeln!(
             s,
-            "| method | setting | error | evaluations | steps | rejected | time |"
+            "| method | setting | error | evaluations | steps | rejected | time | CPU time |"
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
         for ((family, format), mut pts) in curves(&r.measurements, c.name) {
             pts.sort_by_key(|p| p.rhs_evals);
             for p in pts {
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {} | {} | {} | {} | {} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} |",
                     curve_label(family, format),
                     setting(p),
                     sci(p.error),
                     p.rhs_evals,
                     p.steps,
                     p.rejected,
-                    secs(p.wall_s)
+                    secs(p.wall_s),
+                    secs(p.cpu_s)
                 );
             }
         }
