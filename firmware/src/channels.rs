@@ -8,8 +8,8 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex as Cs;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_sync::watch::Watch;
-use kapitza_core::link::serve::Command;
-use kapitza_core::link::{Reason, Status, Telemetry};
+use kapitza_core::link::serve::Effect;
+use kapitza_core::link::{Request, Response, Telemetry};
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::Angle;
 
@@ -26,33 +26,14 @@ pub struct Sample {
     pub late: bool,
 }
 
-/// What the link asks of the control loop.
-#[derive(Clone, Copy)]
-pub enum ToControl {
-    Command(Command),
-    SetConfig(RigConfig),
-    GetStatus,
-    GetConfig,
-}
-
-/// The control loop's answer to a [`ToControl`], in the same order.
-#[derive(Clone, Copy)]
-pub enum FromControl {
-    Done(Result<(), Reason>),
-    Status(Status),
-    Config(RigConfig),
-}
-
 /// pendulum → control: every sample, at the sample rate (a few in flight at most).
 pub static SAMPLES: Channel<Cs, Sample, 8> = Channel::new();
 /// control → pendulum: the sample rate (Hz) of the configuration in use.
 pub static SAMPLE_HZ: Watch<Cs, u32, 1> = Watch::new();
-/// link → control: requests that need the rig, one at a time.
-pub static TO_CONTROL: Channel<Cs, ToControl, 1> = Channel::new();
-/// control → link: the answer to each `TO_CONTROL` request.
-pub static FROM_CONTROL: Channel<Cs, FromControl, 1> = Channel::new();
-/// link → control: a valid frame arrived (resets the link-silence timer).
-pub static LINK_HEARD: Signal<Cs, ()> = Signal::new();
+/// link → control: each valid request, one at a time.
+pub static TO_CONTROL: Channel<Cs, Request, 1> = Channel::new();
+/// control → link: the answer to each `TO_CONTROL` request, and what the link must do with it.
+pub static FROM_CONTROL: Channel<Cs, (Response, Effect), 1> = Channel::new();
 /// control → link: the latest telemetry snapshot.
 pub static TELEMETRY: Watch<Cs, Telemetry, 1> = Watch::new();
 /// control → tilt: the slew-limited θd, degrees along the mount's travel.

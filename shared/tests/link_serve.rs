@@ -294,3 +294,98 @@ fn reasons_read_well() {
         Ok(CFG)
     );
 }
+
+mod server {
+    use super::*;
+    use kapitza_core::link::serve::{Effect, RigServer};
+    use kapitza_core::link::{Response, VersionInfo, WireConfig};
+
+    fn server() -> RigServer {
+        RigServer::new(
+            CFG,
+            ConfigOrigin::Defaults(Fallback::Missing),
+            Tuning::DEFAULT,
+            Angle::ZERO,
+            0,
+            [1, 2, 3],
+        )
+    }
+
+    #[test]
+    fn answers_every_request() {
+        let mut s = server();
+        assert_eq!(
+            s.respond(Request::GetVersion, 10, false, 0),
+            (
+                Response::Version(VersionInfo {
+                    protocol: kapitza_core::link::PROTOCOL_VERSION,
+                    firmware: [1, 2, 3]
+                }),
+                Effect::None
+            )
+        );
+        assert_eq!(
+            s.respond(Request::Telemetry { period_ms: 50 }, 20, false, 0),
+            (Response::Ok, Effect::Telemetry { period_ms: 50 })
+        );
+        assert_eq!(
+            s.respond(Request::GetConfig, 30, false, 0).0,
+            Response::Config(CFG.into())
+        );
+        let (r, _) = s.respond(Request::GetStatus, 40, true, 77);
+        let Response::Status(st) = r else {
+            panic!("{r:?}")
+        };
+        assert_eq!(st.uptime_ms, 77);
+        assert!(st.estop);
+        assert_eq!(st.config, ConfigOrigin::Defaults(Fallback::Missing));
+        let set = Request::SetDrive {
+            r: q(2.0),
+            theta_d_deg: q(45.0),
+        };
+        assert_eq!(s.respond(set, 50, false, 0), (Response::Ok, Effect::None));
+        assert_eq!(s.rig.supervisor().mode(), safety::Mode::Running);
+    }
+
+    #[test]
+    fn configuration_changes_only_when_idle_and_valid() {
+        let mut s = server();
+        let mut new = CFG;
+        new.amplitude = 0.012;
+        // Out of range: refused, nothing changes.
+        let mut bad: WireConfig = new.into();
+        bad.control_hz = 0;
+        let before = s;
+        let (r, e) = s.respond(Request::SetConfig(bad), 10, false, 0);
+        assert!(
+            matches!(r, Response::Refused(Reason::ConfigInvalid { .. })),
+            "{r:?}"
+        );
+        assert_eq!(e, Effect::None);
+        // Only the link keep-alive moved.
+        assert_eq!((s.cfg, s.origin), (before.cfg, before.origin));
+        // Running: refused.
+        s.respond(
+            Request::SetDrive {
+                r: q(1.0),
+                theta_d_deg: 0,
+            },
+            20,
+            false,
+            0,
+        );
+        let (r, _) = s.respond(Request::SetConfig(new.into()), 30, false, 0);
+        assert_eq!(r, Response::Refused(Reason::WrongMode(Mode::Running)));
+        assert_eq!(s.cfg, CFG);
+        // Idle: accepted, to be stored; the status follows the store's outcome.
+        let mut s = server();
+        assert_eq!(
+            s.respond(Request::SetConfig(new.into()), 40, false, 0),
+            (Response::Ok, Effect::StoreConfig(new))
+        );
+        assert_eq!(s.cfg, new);
+        assert_eq!(s.origin, ConfigOrigin::Received { saved: false });
+        s.config_saved(true);
+        assert_eq!(s.origin, ConfigOrigin::Received { saved: true });
+    }
+}

@@ -1,17 +1,16 @@
 //! The laptop link on USART2 (the ST-LINK's virtual COM port): bytes in, frames out.
 //!
-//! Framing, decoding, reasons and the version policy are `kapitza_core::link`; this task moves
-//! bytes and routes requests:
+//! Framing, decoding, reasons and the version policy are `kapitza_core::link`; the answers come
+//! from the control loop's `RigServer`. This task moves bytes:
 //!
 //! ```text
-//! GetVersion                     answered here (frozen, whatever the frame's version)
-//! Telemetry{period}              answered here: the stream's period (≥ MIN_TELEMETRY_MS, or off)
-//! SetConfig                      checked here (RigConfig::validate), then sent to the control loop
-//! GetStatus, GetConfig, SetDrive, Stop, ClearFault   sent to the control loop, its answer relayed
-//! a bad frame                    Refused(reason), seq = the frame's if its CRC passed, else 0
+//! a valid request     → control loop → (response, effect) → the response, seq = the request's;
+//!                       effect Telemetry{period}: stream telemetry (period ≥ MIN_TELEMETRY_MS)
+//! a bad frame         → Refused(reason), seq = the frame's if its CRC passed, else 0
+//! control loop silent → Refused(Busy) after CONTROL_TIMEOUT
 //! ```
-//! Every valid frame resets the rig's link-silence timer. A UART error (overrun, framing,
-//! noise) drops the partial frame and counts as a bad frame; the task never stops.
+//! A UART error (overrun, framing, noise) drops the partial frame and counts as a bad frame; the
+//! task never stops.
 
 use defmt::{info, warn};
 use embassy_futures::select::{select, Either};
@@ -19,37 +18,17 @@ use embassy_stm32::usart::{BufferedUart, BufferedUartTx};
 use embassy_time::{with_timeout, Duration, Instant, Timer};
 use embedded_io_async::{Read, Write};
 use kapitza_core::link::frame::{encode, receive_request, Header};
-use kapitza_core::link::message::Counters;
-use kapitza_core::link::serve::Command;
+use kapitza_core::link::serve::Effect;
 use kapitza_core::link::{
-    FrameReader, Reason, Request, Response, VersionInfo, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME,
-    PROTOCOL_VERSION,
+    FrameReader, Reason, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME, PROTOCOL_VERSION,
 };
 
-use crate::channels::{FromControl, ToControl, FROM_CONTROL, LINK_HEARD, TELEMETRY, TO_CONTROL};
+use crate::channels::{FROM_CONTROL, TELEMETRY, TO_CONTROL};
 
 /// The shortest telemetry period: a telemetry frame is ≤ 100 bytes, 8.7 ms at 115200 baud.
 const MIN_TELEMETRY_MS: u16 = 20;
 /// How long the control loop may take to answer (it answers within one control tick).
 const CONTROL_TIMEOUT: Duration = Duration::from_millis(50);
-
-const fn parse_u16(s: &str) -> u16 {
-    let b = s.as_bytes();
-    let mut v = 0u16;
-    let mut i = 0;
-    while i < b.len() {
-        v = v * 10 + (b[i] - b'0') as u16;
-        i += 1;
-    }
-    v
-}
-
-/// This firmware's version, from its Cargo.toml.
-const FIRMWARE: [u16; 3] = [
-    parse_u16(env!("CARGO_PKG_VERSION_MAJOR")),
-    parse_u16(env!("CARGO_PKG_VERSION_MINOR")),
-    parse_u16(env!("CARGO_PKG_VERSION_PATCH")),
-];
 
 async fn send(tx: &mut BufferedUartTx<'static>, seq: u8, resp: &Response) {
     let mut out = [0u8; MAX_RESPONSE_FRAME];
@@ -64,15 +43,15 @@ async fn send(tx: &mut BufferedUartTx<'static>, seq: u8, resp: &Response) {
 }
 
 /// Asks the control loop and waits for its answer.
-async fn ask(msg: ToControl) -> Option<FromControl> {
+async fn ask(req: Request) -> (Response, Effect) {
     // A late answer to an earlier, timed-out question must not be taken for this one.
     while FROM_CONTROL.try_receive().is_ok() {}
     with_timeout(CONTROL_TIMEOUT, async {
-        TO_CONTROL.send(msg).await;
+        TO_CONTROL.send(req).await;
         FROM_CONTROL.receive().await
     })
     .await
-    .ok()
+    .unwrap_or((Response::Refused(Reason::Busy), Effect::None))
 }
 
 /// The link's own state: frame counters and the telemetry stream.
@@ -86,48 +65,17 @@ struct Link {
 
 impl Link {
     async fn answer(&mut self, req: Request) -> Response {
-        let done = |r: Option<FromControl>| match r {
-            Some(FromControl::Done(Ok(()))) => Response::Ok,
-            Some(FromControl::Done(Err(reason))) => Response::Refused(reason),
-            _ => Response::Refused(Reason::Busy),
-        };
-        match req {
-            Request::GetVersion => Response::Version(VersionInfo {
-                protocol: PROTOCOL_VERSION,
-                firmware: FIRMWARE,
-            }),
-            Request::Telemetry { period_ms } => {
-                self.telemetry = (period_ms > 0)
-                    .then(|| Duration::from_millis(u64::from(period_ms.max(MIN_TELEMETRY_MS))));
-                self.next_telemetry = Instant::now();
-                Response::Ok
-            }
-            Request::SetConfig(w) => match w.to_valid() {
-                Ok(cfg) => done(ask(ToControl::SetConfig(cfg)).await),
-                Err(reason) => Response::Refused(reason),
-            },
-            Request::GetConfig => match ask(ToControl::GetConfig).await {
-                Some(FromControl::Config(c)) => Response::Config(c.into()),
-                _ => Response::Refused(Reason::Busy),
-            },
-            Request::GetStatus => match ask(ToControl::GetStatus).await {
-                Some(FromControl::Status(mut s)) => {
-                    s.counters = Counters {
-                        frames_ok: self.frames_ok,
-                        frames_bad: self.frames_bad,
-                        ..s.counters
-                    };
-                    Response::Status(s)
-                }
-                _ => Response::Refused(Reason::Busy),
-            },
-            Request::SetDrive { .. } | Request::Stop | Request::ClearFault => {
-                match Command::of(&req) {
-                    Some(c) => done(ask(ToControl::Command(c)).await),
-                    None => Response::Refused(Reason::UnknownMessage),
-                }
-            }
+        let (mut resp, effect) = ask(req).await;
+        if let Effect::Telemetry { period_ms } = effect {
+            self.telemetry = (period_ms > 0)
+                .then(|| Duration::from_millis(u64::from(period_ms.max(MIN_TELEMETRY_MS))));
+            self.next_telemetry = Instant::now();
         }
+        if let Response::Status(s) = &mut resp {
+            s.counters.frames_ok = self.frames_ok;
+            s.counters.frames_bad = self.frames_bad;
+        }
+        resp
     }
 }
 
@@ -164,7 +112,6 @@ pub async fn run(uart: BufferedUart<'static>) {
                     let resp = match result {
                         Ok(req) => {
                             link.frames_ok = link.frames_ok.saturating_add(1);
-                            LINK_HEARD.signal(());
                             link.answer(req).await
                         }
                         Err(reason) => {

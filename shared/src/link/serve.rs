@@ -1,9 +1,9 @@
 //! The rig's side of the link, free of hardware: applying a command to a [`Rig`] all or nothing,
-//! and building the status and telemetry messages from it. The firmware calls these from its
-//! control loop; the simulated rig can call the same.
+//! building the status and telemetry messages from it, and [`RigServer`], which answers every
+//! request. The firmware's control loop owns a `RigServer`; a simulated rig can own the same.
 
 use super::convert::{deg_along_travel, from_q16, to_q16};
-use super::message::{Counters, Request, Status, Telemetry};
+use super::message::{Counters, Request, Response, Status, Telemetry, VersionInfo, WireConfig};
 use super::reason::Reason;
 use crate::persist::ConfigOrigin;
 use crate::rig::config::RigConfig;
@@ -144,5 +144,119 @@ pub fn telemetry(
             cfg.limits.drive_angle_min_deg,
         )),
         steady: report.steady,
+    }
+}
+
+/// What the caller must do besides sending the response.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Effect {
+    None,
+    /// A new configuration is in use: store it (then report with [`RigServer::config_saved`]).
+    StoreConfig(RigConfig),
+    /// Stream telemetry every `period_ms` (0: stop), as [`Request::Telemetry`] asked.
+    Telemetry {
+        period_ms: u16,
+    },
+}
+
+/// The rig's side of the conversation in one place: a [`Rig`] with its configuration, where
+/// that came from, and the loop's counters, answering every [`Request`]. The firmware's control
+/// loop owns one; a simulated rig can own one too.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigServer {
+    pub rig: Rig,
+    pub cfg: RigConfig,
+    pub origin: ConfigOrigin,
+    pub counters: Counters,
+    pub tuning: crate::rig::estimator::Tuning,
+    /// This firmware's version, reported by `GetVersion`.
+    pub firmware: [u16; 3],
+}
+
+impl RigServer {
+    /// A stopped rig on `cfg` (which must have passed [`RigConfig::validate`]).
+    pub fn new(
+        cfg: RigConfig,
+        origin: ConfigOrigin,
+        tuning: crate::rig::estimator::Tuning,
+        theta_d0: Angle,
+        now_us: u32,
+        firmware: [u16; 3],
+    ) -> Self {
+        Self {
+            rig: Rig::new(&cfg, &tuning, theta_d0, now_us),
+            cfg,
+            origin,
+            counters: Counters::default(),
+            tuning,
+            firmware,
+        }
+    }
+
+    /// Answers one request (decoded from a valid frame, so it also counts as the link being
+    /// alive). `estop` is the e-stop line now; `uptime_ms` goes into the status.
+    pub fn respond(
+        &mut self,
+        req: Request,
+        now_us: u32,
+        estop: bool,
+        uptime_ms: u32,
+    ) -> (Response, Effect) {
+        self.rig.link_message(now_us);
+        let done = |r: Result<(), Reason>| match r {
+            Ok(()) => Response::Ok,
+            Err(reason) => Response::Refused(reason),
+        };
+        match req {
+            Request::GetVersion => (
+                Response::Version(VersionInfo {
+                    protocol: super::PROTOCOL_VERSION,
+                    firmware: self.firmware,
+                }),
+                Effect::None,
+            ),
+            Request::GetStatus => (
+                Response::Status(status(
+                    &self.rig,
+                    &self.cfg,
+                    estop,
+                    self.origin,
+                    uptime_ms,
+                    self.counters,
+                )),
+                Effect::None,
+            ),
+            Request::SetDrive { .. } | Request::Stop | Request::ClearFault => {
+                let r = match Command::of(&req) {
+                    Some(c) => apply(&mut self.rig, &self.cfg, c),
+                    None => Err(Reason::UnknownMessage),
+                };
+                (done(r), Effect::None)
+            }
+            Request::SetConfig(w) => match self.set_config(w, now_us) {
+                Ok(cfg) => (Response::Ok, Effect::StoreConfig(cfg)),
+                Err(reason) => (Response::Refused(reason), Effect::None),
+            },
+            Request::GetConfig => (Response::Config(self.cfg.into()), Effect::None),
+            Request::Telemetry { period_ms } => (Response::Ok, Effect::Telemetry { period_ms }),
+        }
+    }
+
+    /// A new configuration: valid, and the rig idle; the rig restarts on it with θd kept.
+    fn set_config(&mut self, w: WireConfig, now_us: u32) -> Result<RigConfig, Reason> {
+        let cfg = w.to_valid()?;
+        config_change_allowed(&self.rig)?;
+        let theta_d = self.rig.supervisor().theta_d();
+        self.rig = Rig::new(&cfg, &self.tuning, theta_d, now_us);
+        self.cfg = cfg;
+        self.origin = ConfigOrigin::Received { saved: false };
+        Ok(cfg)
+    }
+
+    /// The store that [`Effect::StoreConfig`] asked for finished (`ok`: it reached flash).
+    pub fn config_saved(&mut self, ok: bool) {
+        if let ConfigOrigin::Received { .. } = self.origin {
+            self.origin = ConfigOrigin::Received { saved: ok };
+        }
     }
 }
