@@ -211,7 +211,7 @@ pub struct SceneOut {
     pub lyapunov: Option<f64>,
     /// ln(1/ε)/λ with ε = 2.2e-16: the time for a rounding-size error to grow to order one.
     pub predictability_s: Option<f64>,
-    /// Median wall time of one evaluation of the right-hand side alone (s).
+    /// Median CPU time of one evaluation of the right-hand side alone (s).
     pub rhs_seconds: f64,
 }
 

@@ -34,7 +34,6 @@ use std::time::Duration;
 use super::clock;
 use super::measure::{error, Family, Point, Reference};
 use super::scenes::BenchScene;
-use crate::timing::seconds_per_eval;
 use kapitza_core::integrate::System;
 use kapitza_core::sim::eom::{FullEom, NoExtra, Viscous};
 use kapitza_core::sim::signal::Steady;
@@ -287,12 +286,12 @@ pub fn peer(
     })
 }
 
-/// Median wall time of one evaluation of the scene's full right-hand side, for judging how much
+/// Median CPU time of one evaluation of the scene's full right-hand side, for judging how much
 /// of a run's time is the equation itself.
 pub fn rhs_cost(scene: &Scene, batch: Duration) -> Result<f64> {
     fn time<S: System<2, f64>>(eom: S, batch: Duration) -> f64 {
         let mut k = 0u32;
-        seconds_per_eval(batch, || {
+        clock::cost(batch, || {
             k = k.wrapping_add(1);
             let t = std::hint::black_box(1e-3 * f64::from(k % 1000));
             let y = std::hint::black_box([2.0, 0.5]);
@@ -300,6 +299,7 @@ pub fn rhs_cost(scene: &Scene, batch: Duration) -> Result<f64> {
             eom.rhs(t, &y, &mut d);
             d
         })
+        .cpu_s
     }
     Ok(match equation(scene)? {
         Equation::Undamped(eom) => time(eom, batch),

@@ -383,7 +383,7 @@ pub fn markdown(r: &Results, command: &str) -> String {
     s.push_str(&peer_table(&r.peer_as_published_ratios));
     let _ = writeln!(
         s,
-        "\nOne evaluation of the right-hand side alone costs {} (the sin/cos of θ and cos ωt).",
+        "\nOne evaluation of the right-hand side alone costs {} of CPU time (the sin/cos of θ and cos ωt).",
         r.scenes
             .iter()
             .map(|c| format!("{} on {}", secs(c.rhs_seconds), c.name))
