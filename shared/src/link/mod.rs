@@ -7,7 +7,10 @@
 //! | [`frame`] | version ‖ seq ‖ postcard ‖ CRC-32C, COBS-stuffed, zero-terminated; the frame reader |
 //! | [`reason`] | [`Reason`]: why a frame or a command was refused, with stable codes and text |
 //! | [`convert`] | the rig's types ↔ their wire images; I16F16 and degree conversions |
-//! | [`serve`] | the rig's side: commands applied all or nothing, status and telemetry built |
+//! | [`serve`] | the rig's side: [`serve::RigServer`] answers every request; commands all or nothing, status and telemetry built |
+//!
+//! The laptop's side is the host tool's `link` module: one method per command, and an error type
+//! that keeps "the line failed" apart from "the rig refused".
 //!
 //! # The conversation
 //!
