@@ -480,13 +480,14 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
             .map_err(e)?;
         for f in fl.iter().filter(|f| f.k == *k) {
             if let Some(x) = f.error {
-                chart
-                    .draw_series([Text::new(
+                // Beside the marker, not on it.
+                let label = EmptyElement::at((f.seconds_per_eval, x.max(FLOOR)))
+                    + Text::new(
                         format!("{}", f.steps_per_period),
-                        (f.seconds_per_eval, x.max(FLOOR)),
+                        (9, -4),
                         ("sans-serif", 13).into_font().color(&c),
-                    )])
-                    .map_err(e)?;
+                    );
+                chart.draw_series([label]).map_err(e)?;
             }
         }
         let steps: Vec<u32> = fl
