@@ -7,7 +7,7 @@ use std::io::Write;
 use crate::input::{self, GeometryArgs};
 use kapitza_core::math;
 use kapitza_core::model::equilibria::saddle_node_r;
-use kapitza_core::model::{equilibria, DriveAngle, Groups, Stability};
+use kapitza_core::model::{equilibria, DriveAngle, Equilibrium, Groups, Stability};
 
 /// Predict every equilibrium of the shaken pendulum (averaged motion) and its stability.
 ///
@@ -89,6 +89,26 @@ pub struct EquilibriumOut {
     pub within_90_of_drive: bool,
 }
 
+impl EquilibriumOut {
+    /// One equilibrium as reported; `omega0` (rad/s), when known, gives ωp in rad/s.
+    pub fn new(e: &Equilibrium, omega0: Option<f64>) -> Self {
+        Self {
+            angle_deg: math::wrap_deg(math::to_deg(e.angle)),
+            stability: match e.stability {
+                Stability::Stable => "stable",
+                Stability::Unstable => "unstable",
+                Stability::Marginal => "marginal",
+            },
+            stable: e.stability == Stability::Stable,
+            marginal: e.stability == Stability::Marginal,
+            margin: e.margin,
+            omega_p_over_omega0: e.omega_p_over_omega0,
+            omega_p: e.omega_p_over_omega0.zip(omega0).map(|(x, w0)| x * w0),
+            within_90_of_drive: e.within_90_of_drive,
+        }
+    }
+}
+
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let report = compute(args)?;
     if args.json {
@@ -131,20 +151,7 @@ pub fn compute(args: &Args) -> Result<Report> {
     let omega0 = physical.as_ref().map(|p| p.omega0);
     let equilibria = eqs
         .as_slice()
-        .map(|e| EquilibriumOut {
-            angle_deg: math::wrap_deg(math::to_deg(e.angle)),
-            stability: match e.stability {
-                Stability::Stable => "stable",
-                Stability::Unstable => "unstable",
-                Stability::Marginal => "marginal",
-            },
-            stable: e.stability == Stability::Stable,
-            marginal: e.stability == Stability::Marginal,
-            margin: e.margin,
-            omega_p_over_omega0: e.omega_p_over_omega0,
-            omega_p: e.omega_p_over_omega0.zip(omega0).map(|(x, w0)| x * w0),
-            within_90_of_drive: e.within_90_of_drive,
-        })
+        .map(|e| EquilibriumOut::new(e, omega0))
         .collect();
     Ok(Report {
         r,

@@ -13,7 +13,7 @@ use crate::scene_file::{self, SceneFile};
 use crate::{csv_out, plot};
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
-use kapitza_core::model::{equilibria, Stability};
+use kapitza_core::model::equilibria;
 use kapitza_core::sim::scene::{Fidelity, FidelityChoice};
 use kapitza_core::sim::{simulate, Format, Method, Options, Report};
 
@@ -190,20 +190,7 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
     let eqs = equilibria(r_effective, scene.drive.angle).context("predicted equilibria")?;
     let predicted = eqs
         .as_slice()
-        .map(|e| EquilibriumOut {
-            angle_deg: outcome::deg(e.angle),
-            stability: match e.stability {
-                Stability::Stable => "stable",
-                Stability::Unstable => "unstable",
-                Stability::Marginal => "marginal",
-            },
-            stable: e.stability == Stability::Stable,
-            marginal: e.stability == Stability::Marginal,
-            margin: e.margin,
-            omega_p_over_omega0: e.omega_p_over_omega0,
-            omega_p: e.omega_p_over_omega0.map(|x| x * p.omega0),
-            within_90_of_drive: e.within_90_of_drive,
-        })
+        .map(|e| EquilibriumOut::new(e, Some(p.omega0)))
         .collect();
     let (method, rtol, atol, steps_per_period) = match file.method {
         Method::Dop853 { rtol, atol } => ("dop853", Some(rtol), Some(atol), None),
