@@ -15,6 +15,15 @@ pub fn deg(rad: f64) -> f64 {
 
 /// An angle in (−180°, 180°] for people, to two decimals: a value that rounds to −180.00 is
 /// shown as 180.00, and −0.00 as 0.00, so the text keeps the interval's convention.
+/// "1 turn", "2 turns".
+fn plural(n: u32, what: &str) -> String {
+    if n == 1 {
+        format!("1 {what}")
+    } else {
+        format!("{n} {what}s")
+    }
+}
+
 pub fn show_deg(deg: f64) -> String {
     let s = format!("{deg:.2}");
     match s.as_str() {
@@ -35,10 +44,11 @@ pub enum OutcomeOut {
     /// Period-`order` motion about `angle_deg`.
     Subharmonic { order: u32, angle_deg: f64 },
     /// Unidirectional rotation: `direction` +1 for increasing θ (counter-clockwise), −1 otherwise;
-    /// one turn every `periods_per_turn` drive periods.
+    /// the motion repeats every `periods` drive periods, making `turns` whole turns in them.
     Rotation {
         direction: i8,
-        periods_per_turn: u32,
+        turns: u32,
+        periods: u32,
     },
     /// Finite-time Lyapunov exponent in 1/s.
     Chaotic { lyapunov: f64 },
@@ -66,10 +76,12 @@ impl From<Outcome> for OutcomeOut {
             },
             Outcome::Rotation {
                 direction,
-                periods_per_turn,
+                turns,
+                periods,
             } => Self::Rotation {
                 direction,
-                periods_per_turn,
+                turns,
+                periods,
             },
             Outcome::Chaotic { lyapunov } => Self::Chaotic { lyapunov },
             Outcome::Oscillation { angle, amplitude } => Self::Oscillation {
@@ -128,10 +140,11 @@ impl fmt::Display for OutcomeOut {
             }
             Self::Rotation {
                 direction,
-                periods_per_turn,
+                turns,
+                periods,
             } => write!(
                 f,
-                "rotation {} (θ {}), one turn per {periods_per_turn} drive period{}",
+                "rotation {} (θ {}), {} every {}",
                 if *direction > 0 {
                     "counter-clockwise"
                 } else {
@@ -142,7 +155,8 @@ impl fmt::Display for OutcomeOut {
                 } else {
                     "decreasing"
                 },
-                if *periods_per_turn == 1 { "" } else { "s" }
+                plural(*turns, "turn"),
+                plural(*periods, "drive period")
             ),
             Self::Chaotic { lyapunov } => {
                 write!(f, "chaotic tumbling, Lyapunov exponent {lyapunov:.3} 1/s")

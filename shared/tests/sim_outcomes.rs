@@ -190,7 +190,8 @@ fn one_turn_per_period_is_rotation() {
         matches!(
             r.outcome,
             Outcome::Rotation {
-                periods_per_turn: 1,
+                turns: 1,
+                periods: 1,
                 ..
             }
         ),

@@ -166,7 +166,7 @@ fn oblique_drive_135() {
 }
 
 #[test]
-fn inverted_180_singular() {
+fn hc15_inverted_180_singular() {
     // θd = 180°, R = 3: φ0 = π, ωp = ω0√(R − 1); the angle formula is 0/0, ωp gives R. The
     // microsecond tick wraps 2 s into the run (the 32-bit counter's 71.6-minute wrap).
     check(
@@ -182,7 +182,7 @@ fn inverted_180_singular() {
 }
 
 #[test]
-fn hanging_0_singular() {
+fn hc15_hanging_0_singular() {
     // θd = 0°, R = 1: φ0 = 0, ωp = ω0√(1 + R) (SPEC §3).
     check(
         "hanging (singular)",
@@ -197,7 +197,7 @@ fn hanging_0_singular() {
 }
 
 #[test]
-fn near_singular_178() {
+fn hc15_near_singular_178() {
     // θd = 178°, R = 3: φ0 ≈ 177°, |sin 2(φ0 − θd)| ≈ 0.035 < 0.05, so R still comes from ωp.
     check(
         "near-singular",

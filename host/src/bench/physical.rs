@@ -55,13 +55,15 @@ pub fn right(a: &OutcomeOut, reference: &OutcomeOut) -> bool {
         (
             O::Rotation {
                 direction: d,
-                periods_per_turn: p,
+                turns: n,
+                periods: p,
             },
             O::Rotation {
                 direction: e,
-                periods_per_turn: q,
+                turns: m,
+                periods: q,
             },
-        ) => d == e && p == q,
+        ) => d == e && n == m && p == q,
         (O::Chaotic { .. }, O::Chaotic { .. }) => true,
         _ => false,
     }

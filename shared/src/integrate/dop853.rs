@@ -33,9 +33,12 @@
 //!
 //! # Precision
 //!
-//! The effective relative tolerance is at least 10·ε of the number format (ε = 2.2e-16 for f64,
-//! 1.2e-7 for f32): no format can meet a tolerance below its own rounding, and asking for one only
-//! shrinks the step until it fails. For f32 this means rtol ≥ 1.2e-6.
+//! The tolerances in force, relative and absolute, are at least 100·ε of the number format
+//! (ε = 2.2e-16 for f64, 1.2e-7 for f32): no format can meet a tolerance near its own rounding.
+//! The error estimate cancels stages much larger than the state (on a fast drive |f| ≈ ω|y|),
+//! and its rounding noise, not the solution, then sets the step: f32 at 1e-6 on a 1.6 kHz drive
+//! took 84–190 steps per period against 3–5 at 1e-5 (hard case HC05, docs/hard-cases.md). For
+//! f32 this means tolerances ≥ 1.2e-5; for f64 ≥ 2.2e-14.
 
 mod dense;
 #[cfg(test)]
@@ -58,9 +61,9 @@ const FAC_MAX: f64 = 6.0;
 /// The settings of a DOP853 run. Build with [`Dop853::new`] and adjust the public fields.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dop853 {
-    /// Relative tolerance (raised to 10·ε of the format if below it).
+    /// Relative tolerance (raised to 100·ε of the format if below it).
     pub rtol: f64,
-    /// Absolute tolerance.
+    /// Absolute tolerance (raised to 100·ε of the format if below it).
     pub atol: f64,
     /// Largest step allowed (time units; infinity for none).
     pub h_max: f64,
@@ -299,13 +302,16 @@ impl Dop853 {
         if !h_ok || !init_ok || !beta_ok {
             return Err(IntegrateError::BadTolerance);
         }
-        let floor = 10.0 * R::EPSILON.to_f64();
+        let floor = TOLERANCE_FLOOR * R::EPSILON.to_f64();
         Ok(Tolerance {
             rtol: self.rtol.max(floor),
-            atol: self.atol,
+            atol: self.atol.max(floor),
         })
     }
 }
+
+/// The tolerances in force are at least this many ε of the number format (see # Precision).
+const TOLERANCE_FLOOR: f64 = 100.0;
 
 #[derive(Debug, Clone, Copy)]
 struct Tolerance {

@@ -24,6 +24,9 @@ pub const MERGE_RAD: f64 = 1e-6;
 pub const MARGIN_TOL: f64 = 1e-9;
 /// A critical point of f with |f| ≤ TOUCH_TOL·scale is a multiple root.
 const TOUCH_TOL: f64 = 1e-13;
+/// Largest R accepted. Beyond it gravity's term sin φ falls toward the rounding of the drive's
+/// (ε·R ≥ 2e-4) and the answer is that of R = ∞; far beyond it (R ≈ 1e308) the margin overflows.
+pub const R_MAX: f64 = 1e12;
 
 /// Stability of an equilibrium of the averaged motion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -92,9 +95,16 @@ pub fn margin(r: f64, theta_d: DriveAngle, phi: f64) -> f64 {
     equilibrium_poly(r, theta_d).derivative().eval(phi)
 }
 
-/// All equilibria of the averaged motion for drive strength R ≥ 0 at drive angle θd.
+/// All equilibria of the averaged motion for drive strength 0 ≤ R ≤ [`R_MAX`] at drive angle θd.
 pub fn equilibria(r: f64, theta_d: DriveAngle) -> Result<Equilibria, ParamError> {
     let r = non_negative("R", r)?;
+    if r > R_MAX {
+        return Err(ParamError {
+            name: "R",
+            value: r,
+            allowed: "at most 1e12 (beyond it the answer is that of R = infinity)",
+        });
+    }
     let f = equilibrium_poly(r, theta_d);
     let fp = f.derivative();
     let roots = f.roots(TOUCH_TOL);
@@ -166,7 +176,8 @@ pub fn saddle_node_r(theta_d: DriveAngle) -> f64 {
 
 /// The effective potential per m g z: v(φ) = −[cos φ + (R/4) cos 2(φ − θd)].
 pub fn effective_potential(r: f64, theta_d: DriveAngle, phi: f64) -> f64 {
-    -(math::cos(phi) + 0.25 * r * math::cos(2.0 * (phi - theta_d.rad())))
+    // φ − θd wrapped first: doubling a huge φ would overflow to ∞ and give cos = NaN.
+    -(math::cos(phi) + 0.25 * r * math::cos(2.0 * math::wrap_pi(phi - theta_d.rad())))
 }
 
 /// The energy of the averaged motion per I ω0²: E = φ'²/(2ω0²) + v(φ), conserved without damping

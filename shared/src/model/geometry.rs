@@ -22,15 +22,17 @@ pub enum Geometry {
 
 impl Geometry {
     pub fn rod(length: f64) -> Result<Self, ParamError> {
-        Ok(Self::Rod {
+        Self::Rod {
             length: positive("length", length)?,
-        })
+        }
+        .with_finite_length()
     }
 
     pub fn point_mass(length: f64) -> Result<Self, ParamError> {
-        Ok(Self::PointMass {
+        Self::PointMass {
             length: positive("length", length)?,
-        })
+        }
+        .with_finite_length()
     }
 
     /// A general body. The parallel-axis theorem requires I ≥ m z², i.e. ℓ ≥ z.
@@ -45,7 +47,24 @@ impl Geometry {
                 allowed: "at least mass * com^2 (parallel-axis theorem)",
             });
         }
-        Ok(Self::General { inertia, mass, com })
+        Self::General { inertia, mass, com }.with_finite_length()
+    }
+
+    /// Checks a body built as a literal — the variants' fields are public, and a decoded rig
+    /// configuration builds them directly — exactly as its constructor would.
+    pub fn validate(self) -> Result<Self, ParamError> {
+        match self {
+            Self::Rod { length } => Self::rod(length),
+            Self::PointMass { length } => Self::point_mass(length),
+            Self::General { inertia, mass, com } => Self::general(inertia, mass, com),
+        }
+    }
+
+    /// Accepted parts can still give ℓ = ∞ (a rod of f64::MAX: 2L overflows; I/(m z) with a
+    /// tiny m z) or ℓ = 0 (a subnormal rod): refused, so that no ω0 = √(g/ℓ) is 0 or ∞.
+    fn with_finite_length(self) -> Result<Self, ParamError> {
+        positive("equivalent length", self.equivalent_length())?;
+        Ok(self)
     }
 
     /// The equivalent length ℓ = I/(m z) in metres: the length of the point-mass pendulum with the

@@ -42,13 +42,20 @@ impl Groups {
         let a = positive("amplitude", amplitude)?;
         let w = positive("omega", omega)?;
         let c = non_negative("damping", c)?;
-        let omega0 = math::sqrt(g / ell);
+        if !(c / w).is_finite() {
+            // δ = c/ω would overflow.
+            return Err(ParamError {
+                name: "damping",
+                value: c,
+                allowed: "a finite number >= 0 with c/omega finite",
+            });
+        }
         Ok(Self {
-            omega0,
-            r: a * a * w * w / (2.0 * g * ell),
-            omega_c: math::sqrt(2.0 * g * ell) / a,
-            m: a / ell,
-            k_abs: g / (ell * w * w),
+            omega0: derived("omega0", math::sqrt(g / ell))?,
+            r: derived("R", a * a * w * w / (2.0 * g * ell))?,
+            omega_c: derived("omega_c", math::sqrt(2.0 * g * ell) / a)?,
+            m: derived("m", a / ell)?,
+            k_abs: derived("k", g / (ell * w * w))?,
             c,
         })
     }
@@ -84,7 +91,16 @@ pub fn omega_for_r(r: f64, ell: f64, gravity: f64, amplitude: f64) -> Result<f64
     let ell = positive("equivalent length", ell)?;
     let g = positive("gravity", gravity)?;
     let a = positive("amplitude", amplitude)?;
-    Ok(math::sqrt(2.0 * g * ell) / a * math::sqrt(r))
+    derived("omega", math::sqrt(2.0 * g * ell) / a * math::sqrt(r))
+}
+
+/// A group computed from accepted inputs can still overflow or underflow (A = 1e200 m gives
+/// R = ∞, a subnormal A gives R = 0): refused rather than returned as ∞ or 0.
+fn derived(name: &'static str, value: f64) -> Result<f64, ParamError> {
+    positive(name, value).map_err(|e| ParamError {
+        allowed: "a finite number > 0 (the inputs overflow or underflow f64)",
+        ..e
+    })
 }
 
 #[cfg(test)]

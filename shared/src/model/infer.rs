@@ -75,7 +75,8 @@ pub fn infer_r(
     omega_p_over_omega0: Option<f64>,
 ) -> Result<RInference, InferError> {
     let phi0 = finite("settled angle", phi0)?;
-    let psi = phi0 - theta_d.rad();
+    // Wrapped, so that 2ψ cannot overflow for a huge (finite) φ0.
+    let psi = math::wrap_pi(phi0 - theta_d.rad());
     let (s2, c2) = math::sin_cos(2.0 * psi);
     let (sp, cp) = math::sin_cos(phi0);
     if s2.abs() >= SINGULAR_SIN {
@@ -99,6 +100,14 @@ pub fn infer_r(
     let r = (wp * wp - cp) / c2;
     if r < 0.0 {
         return Err(InferError::NotAnEquilibrium);
+    }
+    if !r.is_finite() {
+        // (ωp/ω0)² overflowed: no drive gives such a slow frequency.
+        return Err(InferError::Param(ParamError {
+            name: "omega_p/omega0",
+            value: wp,
+            allowed: "small enough that R = ((omega_p/omega0)^2 - cos phi0) / cos 2(phi0 - theta_d) is finite",
+        }));
     }
     let dr = (sp * c2 + 2.0 * (wp * wp - cp) * s2) / (c2 * c2);
     Ok(RInference {

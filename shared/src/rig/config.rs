@@ -117,7 +117,29 @@ impl RigConfig {
     pub fn validate(self) -> Result<Self, ParamError> {
         positive("amplitude", self.amplitude)?;
         positive("gravity", self.gravity)?;
-        positive("equivalent length", self.geometry.equivalent_length())?;
+        // A decoded configuration builds the body as a literal: check it as its constructor would.
+        self.geometry.validate()?;
+        let ell = positive("equivalent length", self.geometry.equivalent_length())?;
+        // The fixed-point constants of `derived` saturate or round to 0 rather than fail: keep
+        // ℓ, A/ℓ and ω0² = g/ℓ inside their formats.
+        if ell >= Q16_MAX {
+            return Err(too_big("equivalent length", ell, "below 32768 m (I16F16)"));
+        }
+        if self.amplitude / ell >= 2.0 {
+            return Err(too_big(
+                "amplitude",
+                self.amplitude,
+                "below 2 equivalent lengths (A/l in I2F30)",
+            ));
+        }
+        let omega0_sq = self.gravity / ell;
+        if !(1.0 / 65_536.0..Q16_MAX).contains(&omega0_sq) {
+            return Err(too_big(
+                "gravity",
+                self.gravity,
+                "with g/l in [2^-16, 32768) 1/s^2 (omega0^2 in I16F16)",
+            ));
+        }
         let l = &self.limits;
         positive("omega_max", l.omega_max)?;
         if l.omega_max >= 30_000.0 {
@@ -143,9 +165,17 @@ impl RigConfig {
             ));
         }
         positive("drive_angle_rate_max_deg", l.drive_angle_rate_max_deg)?;
-        positive("current_max", l.current_max)?;
-        positive("stall_min_omega", l.stall_min_omega)?;
-        positive("stall_fraction", l.stall_fraction)?;
+        q16("current_max", l.current_max)?;
+        q16("stall_min_omega", l.stall_min_omega)?;
+        // The stall test multiplies the commanded speed by this fraction in i64 (Q16): above 1
+        // it means nothing, and far above it the product overflows.
+        if positive("stall_fraction", l.stall_fraction)? > 1.0 {
+            return Err(too_big(
+                "stall_fraction",
+                l.stall_fraction,
+                "a fraction in (0, 1]",
+            ));
+        }
         if !(l.drive_angle_min_deg.is_finite()
             && l.drive_angle_max_deg.is_finite()
             && l.drive_angle_min_deg < l.drive_angle_max_deg
@@ -157,11 +187,21 @@ impl RigConfig {
                 "finite, above drive_angle_min_deg, and less than a turn from it",
             ));
         }
-        positive("omega_per_duty", self.motor.omega_per_duty)?;
-        positive("lag", self.motor.lag)?;
-        positive("kp", self.motor.kp)?;
-        positive("ki", self.motor.ki)?;
-        positive("max_correction", self.motor.max_correction)?;
+        // The duty conversion multiplies by 2^30/omega_per_duty in i64: at least 1 rad/s keeps
+        // the product below 2^61.
+        if positive("omega_per_duty", self.motor.omega_per_duty)? < 1.0 {
+            return Err(too_big(
+                "omega_per_duty",
+                self.motor.omega_per_duty,
+                "at least 1 rad/s",
+            ));
+        }
+        // The phase lock holds these in I16F16; a gain below one LSB would be 0 (and ki = 0
+        // divides by zero in the anti-windup limit).
+        q16("lag", self.motor.lag)?;
+        q16("kp", self.motor.kp)?;
+        q16("ki", self.motor.ki)?;
+        q16("max_correction", self.motor.max_correction)?;
         if self.control_hz == 0
             || !self.sample_hz.is_multiple_of(self.control_hz)
             || self.sample_hz > 100_000
@@ -204,6 +244,18 @@ impl RigConfig {
             theta_d_min: Angle::from_deg(self.limits.drive_angle_min_deg),
             theta_d_max: Angle::from_deg(self.limits.drive_angle_max_deg),
         }
+    }
+}
+
+/// The end of the I16F16 range (RadPerSec, Amps, Ratio).
+const Q16_MAX: f64 = 32_768.0;
+
+/// A positive number that I16F16 holds without saturating to its end or rounding to 0.
+fn q16(name: &'static str, value: f64) -> Result<f64, ParamError> {
+    if value.is_finite() && (1.0 / 65_536.0..Q16_MAX).contains(&value) {
+        Ok(value)
+    } else {
+        Err(too_big(name, value, "a number in [2^-16, 32768) (I16F16)"))
     }
 }
 

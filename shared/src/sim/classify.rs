@@ -54,10 +54,13 @@ pub enum Outcome {
         order: u32,
         angle: f64,
     },
-    /// Unidirectional rotation: +1 counter-clockwise (θ increasing), −1 otherwise.
+    /// Unidirectional rotation: +1 counter-clockwise (θ increasing), −1 otherwise; the motion
+    /// repeats every `periods` drive periods, in which it makes `turns` whole turns (a period-2
+    /// orbit may turn once or twice in its two periods).
     Rotation {
         direction: i8,
-        periods_per_turn: u32,
+        turns: u32,
+        periods: u32,
     },
     /// Positive finite-time Lyapunov exponent (1/s).
     Chaotic {
@@ -185,7 +188,8 @@ pub fn classify(
         if turn.abs() > math::PI {
             return Outcome::Rotation {
                 direction: if turn > 0.0 { 1 } else { -1 },
-                periods_per_turn: p as u32,
+                turns: libm::round(turn.abs() / math::TAU) as u32,
+                periods: p as u32,
             };
         }
         let distinct = (0..p).any(|i| {
@@ -336,7 +340,25 @@ mod tests {
             classify(&spin, W, false, no_lyapunov),
             Outcome::Rotation {
                 direction: 1,
-                periods_per_turn: 1
+                turns: 1,
+                periods: 1
+            }
+        );
+        // Two turns in two periods, the second faster: period 2, not 1.
+        let uneven = fill(
+            |k| Strobe {
+                theta: k as f64 * math::TAU + if k % 2 == 0 { 0.0 } else { 0.5 },
+                rate: 15.0 + (k % 2) as f64,
+                mean: 0.0,
+            },
+            200,
+        );
+        assert_eq!(
+            classify(&uneven, W, false, no_lyapunov),
+            Outcome::Rotation {
+                direction: 1,
+                turns: 2,
+                periods: 2
             }
         );
         // One turn clockwise every 2 periods.
@@ -352,7 +374,8 @@ mod tests {
             classify(&rot, W, false, no_lyapunov),
             Outcome::Rotation {
                 direction: -1,
-                periods_per_turn: 2
+                turns: 1,
+                periods: 2
             }
         );
     }

@@ -15,6 +15,7 @@ use super::eom::{FullEom, NoExtra, Sliding};
 use super::run::{Context, Dense, Method, RunOut, SimError};
 use super::sampling::{Interpolant, Recorder, Sampler};
 use super::signal::DriveSignal;
+use super::turns::{Shifted, Turns};
 use crate::integrate::{Dop853, Stats, StepControl};
 use crate::Real;
 
@@ -63,9 +64,12 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
 
     let mut work = Stats::default();
     let mut sticks = 0u64;
-    let (mut t, mut theta, mut rate) = (0.0, ctx.y0.0, ctx.y0.1);
+    // θ is kept reduced by whole turns, as in every smooth run (see `turns`).
+    let mut turns = Turns::new(true);
+    let (mut t, mut theta, mut rate) = (0.0, turns.reduce(ctx.y0.0), ctx.y0.1);
     let mut stalled = 0u32;
     while t < ctx.t_end {
+        let offset = turns.offset();
         let direction = if rate != 0.0 {
             rate.signum()
         } else {
@@ -73,7 +77,8 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
             if a.abs() <= mu {
                 sticks += 1;
                 let force = |s: f64| held(s, R::from_f64(theta));
-                t = stick(t, theta, mu, check_dt, ctx.t_end, &force, &mut sampler);
+                let still = (theta, offset);
+                t = stick(t, still, mu, check_dt, ctx.t_end, &force, &mut sampler);
                 if t >= ctx.t_end {
                     break;
                 }
@@ -88,6 +93,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
         });
         let y0 = [R::from_f64(theta), R::from_f64(rate)];
         let start = t;
+        let mut stopped = false;
         let sol = solver.solve(&sliding, t, y0, ctx.t_end, |step| {
             let stop = step.find_crossing(|_, y| y[1].to_f64() * direction);
             let t1 = stop.unwrap_or(step.t1);
@@ -96,13 +102,24 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
             } else {
                 step.y1
             };
-            sampler.step(t1, (end[0].to_f64(), end[1].to_f64()), &mut Dense(step));
-            stop.map_or(StepControl::Continue, StepControl::StopAt)
+            let (theta, rate) = (end[0].to_f64(), end[1].to_f64());
+            sampler.step(
+                t1,
+                (theta + offset, rate),
+                &mut Shifted(Dense(step), offset),
+            );
+            stopped = stop.is_some();
+            match stop {
+                Some(t1) => StepControl::StopAt(t1),
+                // Whole turns out of θ, then the same sliding segment goes on.
+                None if turns.due(step.y1[0]) => StepControl::Stop,
+                None => StepControl::Continue,
+            }
         })?;
         work.add(sol.stats);
         t = sol.t;
-        theta = sol.y[0].to_f64();
-        rate = if t < ctx.t_end {
+        theta = turns.reduce(sol.y[0].to_f64());
+        rate = if stopped && t < ctx.t_end {
             0.0
         } else {
             sol.y[1].to_f64()
@@ -122,32 +139,36 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     Ok(RunOut {
         sampler,
         work,
-        end: (t, theta, rate),
+        end: (t, theta + turns.offset(), rate),
         sticks: Some(sticks),
     })
 }
 
-/// Holds the pendulum at θ from t0 until |a(t)| > μ (or the run ends), feeding the sampler the
-/// still state; returns the release time, bisected between checks.
+/// Holds the pendulum at θ (reduced, with its turns' offset) from t0 until |a(t)| > μ (or the
+/// run ends), feeding the sampler the still state; returns the release time, bisected between
+/// checks. Check times are t0 + i·dt, computed afresh.
 fn stick<Rec: Recorder>(
     t0: f64,
-    theta: f64,
+    (theta, offset): (f64, f64),
     mu: f64,
     dt: f64,
     t_end: f64,
     force: &dyn Fn(f64) -> f64,
     sampler: &mut Sampler<'_, Rec>,
 ) -> f64 {
+    let shown = theta + offset;
     let mut t = t0;
+    let mut checks = 0u64;
     while t < t_end {
-        let t1 = (t + dt).min(t_end);
+        checks += 1;
+        let t1 = (t0 + checks as f64 * dt).min(t_end);
         if force(t1).abs() > mu {
             // |a| − μ is ≤ 0 at t and > 0 at t1.
             let release = crate::math::bisect(|s| force(s).abs() - mu, t, t1, -1.0);
-            sampler.step(release, (theta, 0.0), &mut Still(theta));
+            sampler.step(release, (shown, 0.0), &mut Still(shown));
             return release;
         }
-        sampler.step(t1, (theta, 0.0), &mut Still(theta));
+        sampler.step(t1, (shown, 0.0), &mut Still(shown));
         t = t1;
     }
     t

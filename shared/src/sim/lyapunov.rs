@@ -11,6 +11,7 @@
 
 use super::run::{Context, Job};
 use super::sampling::strobe_time;
+use super::turns::Turns;
 use crate::integrate::{Dop853, Stats, System};
 use crate::{math, Real};
 
@@ -38,6 +39,7 @@ impl<R: Real> Job<R> for Exponent<'_> {
 
     fn run<S: System<2, R> + Copy>(self, sys: S) -> (f64, Stats) {
         let (k0, t0, theta, rate) = self.start;
+        let theta = Turns::new(self.ctx.periodic).reduce(theta);
         let omega = self.ctx.omega;
         let d0 = 10.0 * math::sqrt(R::EPSILON.to_f64());
         let pair = Pair(sys);
@@ -64,10 +66,12 @@ impl<R: Real> Job<R> for Exponent<'_> {
             }
             sum += libm::log(d / d0);
             let scale = d0 / d;
+            // Only the difference matters: whole turns come out of the reference angle.
+            let theta = Turns::new(self.ctx.periodic).reduce(sol.y[0]);
             y = [
-                sol.y[0],
+                theta,
                 sol.y[1],
-                sol.y[0] + R::from_f64(dth * scale),
+                theta + R::from_f64(dth * scale),
                 sol.y[1] + R::from_f64(dv * omega * scale),
             ];
             t = t1;

@@ -11,6 +11,7 @@
 //! | [`sensor`] | the pivot encoder: sampled, noisy, quantised |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
+//! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
 //! | [`run`] | `simulate`: compose, integrate, sample, classify |
 
 pub mod classify;
@@ -23,6 +24,7 @@ pub mod sampling;
 pub mod scene;
 pub mod sensor;
 pub mod signal;
+mod turns;
 
 pub use classify::Outcome;
 pub use run::{simulate, Format, Method, Options, Report, SimError};

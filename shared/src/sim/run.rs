@@ -16,6 +16,7 @@ use super::sampling::{Hermite, Interpolant, Recorder, Sampler};
 use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
+use super::turns::{Shifted, Turns};
 use crate::integrate::{
     rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
     StepControl, Symplectic, System,
@@ -153,6 +154,8 @@ pub(super) struct Context {
     pub omega: f64,
     pub undamped: bool,
     pub classify: bool,
+    /// The equation is 2π-periodic in θ (full and averaged), so whole turns may be taken out.
+    pub periodic: bool,
 }
 
 /// The raw result of a generic run, before classification.
@@ -180,14 +183,13 @@ pub fn simulate<Rec: Recorder>(
 }
 
 fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), SimError> {
+    let steps_ok = |spp: f64| spp > 0.0 && spp <= MAX_STEPS_PER_PERIOD;
     match options.method {
         Method::Symplectic {
             steps_per_period, ..
         } => {
-            if !(steps_per_period.is_finite() && steps_per_period > 0.0) {
-                return Err(SimError::Unsupported(
-                    "run.steps_per_period must be a finite number > 0",
-                ));
+            if !steps_ok(steps_per_period) {
+                return Err(SimError::Unsupported(STEPS_PER_PERIOD_RANGE));
             }
             if p.c > 0.0 || scene.effects.coulomb.is_some() {
                 return Err(SimError::Unsupported(
@@ -196,10 +198,8 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
             }
         }
         Method::Rk4 { steps_per_period } => {
-            if !(steps_per_period.is_finite() && steps_per_period > 0.0) {
-                return Err(SimError::Unsupported(
-                    "run.steps_per_period must be a finite number > 0",
-                ));
+            if !steps_ok(steps_per_period) {
+                return Err(SimError::Unsupported(STEPS_PER_PERIOD_RANGE));
             }
             if scene.effects.coulomb.is_some() {
                 return Err(SimError::Unsupported(
@@ -220,13 +220,22 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
             }
         }
     }
-    if !(options.out_dt.is_finite() && options.out_dt >= 0.0) {
+    let out_dt = options.out_dt;
+    let t_end = scene.duration(p.omega);
+    if !(out_dt == 0.0 || (out_dt > 0.0 && t_end / out_dt <= MAX_OUTPUT_SAMPLES)) {
         return Err(SimError::Unsupported(
-            "the output interval must be a finite number >= 0",
+            "the output interval must be 0 (none) or a finite number > 0 giving at most 1e9 samples",
         ));
     }
     Ok(())
 }
+
+/// More steps per drive period than any accuracy needs (RK4's error is at rounding by 10⁴);
+/// beyond it a run is a mistake that would take forever.
+const MAX_STEPS_PER_PERIOD: f64 = 1e6;
+const STEPS_PER_PERIOD_RANGE: &str = "run.steps_per_period must be a number > 0 and <= 1e6";
+/// Output samples a run may write.
+const MAX_OUTPUT_SAMPLES: f64 = 1e9;
 
 /// The drive signal a scene needs: the steady sinusoid unless something shapes it.
 fn shaped(scene: &Scene) -> bool {
@@ -273,6 +282,7 @@ fn run_format<R: Real, Rec: Recorder>(
         omega: p.omega,
         undamped: p.c == 0.0 && scene.effects.coulomb.is_none(),
         classify: options.classify,
+        periodic: decision.fidelity != Fidelity::Linearised,
     };
     let a1 = p.amplitude / p.ell;
     if shaped(scene) {
@@ -425,6 +435,10 @@ fn pair<R: Real>(y: &[R; 2]) -> (f64, f64) {
 }
 
 /// Integrates a smooth equation with the chosen method, feeding the sampler.
+///
+/// The integrators see the angle reduced by whole turns ([`Turns`]): a run stops when the angle
+/// is due for reduction and restarts from the reduced state, at the same step size and, for the
+/// fixed-step methods, at the same step times t_i = i·h.
 pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     sys: S,
     ctx: &Context,
@@ -440,88 +454,138 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
         rec,
     );
     sampler.start(ctx.y0.0, ctx.y0.1);
-    let y0 = [R::from_f64(ctx.y0.0), R::from_f64(ctx.y0.1)];
-    let (t, y, work) = match ctx.method {
+    let mut turns = Turns::new(ctx.periodic);
+    let mut y = [turns.reduce(R::from_f64(ctx.y0.0)), R::from_f64(ctx.y0.1)];
+    let mut t = 0.0;
+    let mut work = Stats::default();
+    match ctx.method {
         Method::Dop853 { rtol, atol } => {
             let mut solver = Dop853::new(rtol, atol);
             // A step may not jump over a whole drive period unseen (long runs of the averaged
             // model would otherwise step past the strobes' resolution of the slow motion).
             solver.h_max = 16.0 * ctx.period;
             solver.max_steps = u64::MAX;
-            let sol = solver.solve(&sys, 0.0, y0, ctx.t_end, |step| {
-                sampler.step(step.t1, pair(&step.y1), &mut Dense(step));
-                StepControl::Continue
-            })?;
-            (sol.t, sol.y, sol.stats)
+            loop {
+                let offset = turns.offset();
+                let mut last_h = None;
+                let sol = solver.solve(&sys, t, y, ctx.t_end, |step| {
+                    let (theta, rate) = pair(&step.y1);
+                    sampler.step(
+                        step.t1,
+                        (theta + offset, rate),
+                        &mut Shifted(Dense(step), offset),
+                    );
+                    last_h = Some(step.t1 - step.t0);
+                    if turns.due(step.y1[0]) {
+                        StepControl::Stop
+                    } else {
+                        StepControl::Continue
+                    }
+                })?;
+                work.add(sol.stats);
+                (t, y) = (sol.t, sol.y);
+                if t >= ctx.t_end {
+                    break;
+                }
+                y[0] = turns.reduce(y[0]);
+                solver.h_init = last_h;
+            }
         }
         Method::Symplectic {
             scheme,
             steps_per_period,
         } => {
-            let n = libm::round(ctx.t_end / ctx.period * steps_per_period).max(1.0) as u64;
-            let h = ctx.t_end / n as f64;
+            let (n, h) = fixed_steps(ctx, steps_per_period);
             let force = AtRest(&sys);
-            let x0 = Phase {
-                q: [y0[0]],
-                v: [y0[1]],
-            };
-            let mut prev = (0.0, y0);
-            let mut extra = 0u64;
-            let sol = symplectic_fixed(scheme, &force, 0.0, x0, h, n, |t, x| {
-                let y = [x.q[0], x.v[0]];
-                let mut interp = LazyHermite {
-                    sys: &sys,
-                    t0: prev.0,
-                    t1: t,
-                    y0: prev.1,
-                    y1: y,
-                    ready: None,
-                    evals: &mut extra,
+            let mut done = 0u64;
+            while done < n {
+                let offset = turns.offset();
+                let mut prev = (t, y);
+                let mut extra = 0u64;
+                let x0 = Phase {
+                    q: [y[0]],
+                    v: [y[1]],
                 };
-                sampler.step(t, pair(&y), &mut interp);
-                prev = (t, y);
-                Control::Continue
-            });
-            let mut work = sol.stats;
-            work.rhs_evals += extra;
-            (sol.t, [sol.y.q[0], sol.y.v[0]], work)
+                // Times of this stretch are t0 + j·h with t0 = done·h: each computed afresh.
+                let sol = symplectic_fixed(scheme, &force, t, x0, h, n - done, |t, x| {
+                    let y = [x.q[0], x.v[0]];
+                    observe(&mut sampler, &sys, prev, (t, y), offset, &mut extra);
+                    prev = (t, y);
+                    stop_if(turns.due(y[0]))
+                });
+                work.add(sol.stats);
+                work.rhs_evals += extra;
+                done += sol.stats.steps;
+                (t, y) = (done as f64 * h, [turns.reduce(sol.y.q[0]), sol.y.v[0]]);
+            }
         }
         Method::Rk4 { steps_per_period } => {
-            let n = libm::round(ctx.t_end / ctx.period * steps_per_period).max(1.0) as u64;
-            let h = ctx.t_end / n as f64;
-            let mut prev = (0.0, y0);
-            let mut extra = 0u64;
-            let sol = rk4_observe(&sys, 0.0, y0, h, n, |t, y| {
-                let mut interp = LazyHermite {
-                    sys: &sys,
-                    t0: prev.0,
-                    t1: t,
-                    y0: prev.1,
-                    y1: *y,
-                    ready: None,
-                    evals: &mut extra,
-                };
-                sampler.step(t, pair(y), &mut interp);
-                prev = (t, *y);
-                Control::Continue
-            });
-            let mut work = sol.stats;
-            work.rhs_evals += extra;
-            (sol.t, sol.y, work)
+            let (n, h) = fixed_steps(ctx, steps_per_period);
+            let mut done = 0u64;
+            while done < n {
+                let offset = turns.offset();
+                let mut prev = (t, y);
+                let mut extra = 0u64;
+                let sol = rk4_observe(&sys, t, y, h, n - done, |t, y| {
+                    observe(&mut sampler, &sys, prev, (t, *y), offset, &mut extra);
+                    prev = (t, *y);
+                    stop_if(turns.due(y[0]))
+                });
+                work.add(sol.stats);
+                work.rhs_evals += extra;
+                done += sol.stats.steps;
+                (t, y) = (done as f64 * h, [turns.reduce(sol.y[0]), sol.y[1]]);
+            }
         }
-    };
+    }
     for v in y {
         if !v.is_finite() {
             return Err(SimError::Integrate(IntegrateError::NonFinite { t }));
         }
     }
-    let end = (t, y[0].to_f64(), y[1].to_f64());
+    let end = (t, y[0].to_f64() + turns.offset(), y[1].to_f64());
     Ok(RunOut {
         sampler,
         work,
         end,
         sticks: None,
     })
+}
+
+/// The step count and size of a fixed-step run: whole steps, the last landing on t_end.
+fn fixed_steps(ctx: &Context, steps_per_period: f64) -> (u64, f64) {
+    let n = libm::round(ctx.t_end / ctx.period * steps_per_period).max(1.0) as u64;
+    (n, ctx.t_end / n as f64)
+}
+
+fn stop_if(due: bool) -> Control {
+    if due {
+        Control::Stop
+    } else {
+        Control::Continue
+    }
+}
+
+/// Hands a fixed step from `prev` to `next` to the sampler, with its turns added back.
+fn observe<R: Real, S: System<2, R>, Rec: Recorder>(
+    sampler: &mut Sampler<'_, Rec>,
+    sys: &S,
+    prev: (f64, [R; 2]),
+    next: (f64, [R; 2]),
+    offset: f64,
+    extra: &mut u64,
+) {
+    let (theta, rate) = pair(&next.1);
+    let interp = LazyHermite {
+        sys,
+        t0: prev.0,
+        t1: next.0,
+        y0: prev.1,
+        y1: next.1,
+        ready: None,
+        evals: extra,
+    };
+    sampler.step(next.0, (theta + offset, rate), &mut Shifted(interp, offset));
 }
 
 /// An undamped equation seen as a force: θ'' = a(t, θ), evaluated at θ' = 0 (the extras of an

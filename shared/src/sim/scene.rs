@@ -129,13 +129,33 @@ fn check(key: &'static str, value: f64, ok: bool, allowed: &'static str) -> Resu
     }
 }
 
-/// Longest run accepted, in drive periods: 10⁹ keeps every step index exact in f64.
+/// Longest run accepted, in drive periods: 10⁹ keeps every step index exact in f64. A run given
+/// in seconds is held to the same count, and so is the count of its fastest time scale — the
+/// drive, the pendulum's own swing (ω0), the damping (c) or the initial rate of turning — which
+/// sets the number of steps.
 pub const MAX_PERIODS: f64 = 1e9;
+
+/// Fastest drive accepted (rad/s). The sampler takes instants within 1e-12 s of a step's end as
+/// that end, so a drive period must stay far above it; 1e6 rad/s (6.3 µs) is 6e6 times it, and
+/// 2400 times the rig's limit.
+pub const MAX_OMEGA: f64 = 1e6;
+
+/// The scene key of a body's parameter, for a [`ParamError`] from [`Geometry::validate`].
+fn pendulum_key(name: &str) -> &'static str {
+    match name {
+        "length" => "pendulum.length",
+        "inertia" => "pendulum.inertia",
+        "mass" => "pendulum.mass",
+        "com" => "pendulum.com",
+        _ => "pendulum",
+    }
+}
 
 impl Scene {
     /// Checks every number once; nothing runs on a scene that fails.
     pub fn check(&self) -> Result<(), SceneError> {
         let d = &self.drive;
+        self.check_pendulum()?;
         check(
             "drive.amplitude",
             d.amplitude,
@@ -221,11 +241,13 @@ impl Scene {
                 (4..=24).contains(&s.bits),
                 "an integer in [4, 24]",
             )?;
+            // Noise beyond a turn means nothing, and far beyond it (σ·|n| > 6.7e301 rad with a
+            // 24-bit encoder) the quantiser's count overflows and the sample is NaN.
             check(
                 "effects.sensor.noise_deg",
                 crate::math::to_deg(s.noise),
-                s.noise >= 0.0,
-                "a finite number >= 0",
+                s.noise >= 0.0 && s.noise <= crate::math::TAU,
+                "a number in [0, 360] degrees",
             )?;
             check(
                 "effects.sensor.rate_hz",
@@ -242,20 +264,80 @@ impl Scene {
                 "a finite number > 0 (s)",
             )?;
         }
-        let p = self.physical()?;
         // The full equation is exact for any stroke; only averaging needs A << l (see fidelity).
         // Ten pendulum lengths is far past any rig and guards against unit slips (mm for m).
+        // Checked before the derived constants, so that a tiny pendulum is reported here rather
+        // than as an overflow of g/ℓ.
         check(
             "drive.amplitude",
             d.amplitude,
-            d.amplitude < 10.0 * p.ell,
+            d.amplitude < 10.0 * self.pendulum.equivalent_length(),
             "less than 10 equivalent lengths (m)",
+        )?;
+        let p = self.physical()?;
+        let (key, given) = self.frequency();
+        check(
+            key,
+            given,
+            p.omega <= MAX_OMEGA,
+            "a drive of at most 1e6 rad/s",
+        )?;
+        // The drive's angular acceleration ω/T during a ramp or motor lag must be finite.
+        if let Some(t) = e.ramp {
+            check(
+                "effects.ramp.seconds",
+                t,
+                (p.omega / t).is_finite(),
+                "long enough that omega / ramp is finite (s)",
+            )?;
+        }
+        if let Some(t) = e.actuator {
+            check(
+                "effects.actuator.lag_s",
+                t,
+                (p.omega / t).is_finite(),
+                "long enough that omega / lag is finite (s)",
+            )?;
+        }
+        let fastest = p.omega.max(p.omega0).max(p.c).max(self.initial_rate.abs());
+        let seconds = self.duration(p.omega);
+        let (key, value) = match self.length {
+            RunLength::Periods(n) => ("run.periods", n),
+            RunLength::Duration(s) => ("run.duration", s),
+        };
+        check(
+            key,
+            value,
+            seconds > 0.0 && seconds * fastest / crate::math::TAU <= MAX_PERIODS,
+            "longer than 0 s and at most 1e9 periods of the fastest of the drive, omega0, the damping c and the initial rate",
         )?;
         Ok(())
     }
 
-    /// The derived physical constants every model needs.
+    /// The drive frequency as given: its key and value.
+    fn frequency(&self) -> (&'static str, f64) {
+        match self.drive.frequency {
+            DriveFrequency::Omega(w) => ("drive.omega", w),
+            DriveFrequency::R(r) => ("drive.r", r),
+        }
+    }
+
+    /// The body, checked as its constructor would (a literal may hold any numbers).
+    fn check_pendulum(&self) -> Result<(), SceneError> {
+        match self.pendulum.validate() {
+            Ok(_) => Ok(()),
+            Err(e) => Err(SceneError {
+                key: pendulum_key(e.name),
+                value: e.value,
+                allowed: e.allowed,
+            }),
+        }
+    }
+
+    /// The derived physical constants every model needs. Each is checked: numbers that pass
+    /// [`Scene::check`] one by one can still overflow together (g/ℓ, A²ω², ω0/Q).
     pub fn physical(&self) -> Result<Physical, SceneError> {
+        self.check_pendulum()?;
         let ell = self.pendulum.equivalent_length();
         let g_eff = self.gravity * self.effects.tilt.map_or(1.0, crate::math::cos);
         let omega0 = crate::math::sqrt(g_eff / ell);
@@ -271,12 +353,29 @@ impl Scene {
             Some(Viscous::Gamma(g)) => 2.0 * g,
         };
         let r = a * a * omega * omega / (2.0 * g_eff * ell);
+        let positive = "a finite number > 0 (the scene's numbers overflow or underflow together)";
         check(
-            "drive.omega",
-            omega,
-            omega > 0.0,
-            "a finite number > 0 (rad/s)",
+            "environment.gravity",
+            self.gravity,
+            g_eff > 0.0 && omega0.is_finite() && omega0 > 0.0,
+            "a finite number > 0 with g/l finite and > 0 (m/s², pendulum length in m)",
         )?;
+        let (key, given) = self.frequency();
+        check(key, given, omega.is_finite() && omega > 0.0, positive)?;
+        // R overflows through the drive, (Aω)², or through a vanishing 2gℓ: name the one at fault.
+        check(key, given, (a * omega * a * omega).is_finite(), positive)?;
+        check(
+            "environment.gravity",
+            self.gravity,
+            r.is_finite(),
+            "large enough that R = A²ω²/(2gℓ) is finite (m/s²)",
+        )?;
+        let (key, given) = match self.effects.viscous {
+            Some(Viscous::Gamma(g)) => ("effects.viscous.gamma", g),
+            Some(Viscous::Q(q)) => ("effects.viscous.q", q),
+            None => ("effects.viscous", 0.0),
+        };
+        check(key, given, c.is_finite(), positive)?;
         Ok(Physical {
             ell,
             g_eff,

@@ -83,6 +83,16 @@ pub struct DriveState {
 impl Schedule {
     pub fn state(&self, t: f64) -> DriveState {
         let w = self.omega;
+        if t < 0.0 && (self.ramp.is_some() || self.lag.is_some()) {
+            // Before t = 0 a ramped or lagging drive is at rest. Only the backward sub-steps of a
+            // Yoshida composition ask for it; the formulas below, continued to t < 0, give a
+            // phase of W t²/(2T) and an e^{−t/τ} that overflow for a short ramp or lag.
+            return DriveState {
+                phase: 0.0,
+                omega: 0.0,
+                omega_dot: 0.0,
+            };
+        }
         match (self.ramp, self.lag) {
             (None, None) => DriveState {
                 phase: w * t,

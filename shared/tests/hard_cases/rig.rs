@@ -1,10 +1,11 @@
-//! The rig logic's hard cases (SPEC §6; `docs/hard-cases.md`): saturation at large angular
-//! velocity, the 32-bit microsecond tick wrapping, no drift or windup over long runs, and a
-//! pendulum rotating for hours. Exact phase over 10⁹ periods is in `rig_dds.rs`.
+//! HC10–HC14: the rig logic's hard cases (fixed point and time, run on the microcontroller):
+//! exact drive phase over 10⁹ periods by jump-ahead, saturation at large angular velocity, the
+//! 32-bit microsecond tick wrapping, no drift or windup over long runs, and a pendulum rotating
+//! for hours.
 
 use kapitza_core::math;
 use kapitza_core::rig::config::RigConfig;
-use kapitza_core::rig::dds::{word_from_omega, Dds};
+use kapitza_core::rig::dds::{omega_of_word, word_from_omega, Dds};
 use kapitza_core::rig::estimator::period::{PeriodAverager, MAX_SAMPLES};
 use kapitza_core::rig::estimator::{slow_rate, Estimate, Estimator, Tuning};
 use kapitza_core::rig::fixed::{Angle, RadPerSec};
@@ -43,7 +44,7 @@ fn pendulum(phi0: f64, omega: f64) -> impl Fn(f64) -> f64 {
 }
 
 #[test]
-fn saturation_at_large_angular_velocity() {
+fn hc11_saturation_at_large_angular_velocity() {
     // Rotation at 0.45 turn per sample (28 274 rad/s at 10 kHz, just inside the unwrap limit
     // π·fs): sums do not overflow (debug overflow checks are on in tests) and the slow rate is
     // right to 0.1 %. Expected: 0.45·2π·10⁴ rad/s (closed form); period means are stamped at
@@ -74,7 +75,7 @@ fn saturation_at_large_angular_velocity() {
 }
 
 #[test]
-fn microsecond_tick_wrap_changes_nothing() {
+fn hc12_microsecond_tick_wrap_changes_nothing() {
     // The same samples stamped from 0 and from 3 s before the u32 wrap (71.6 min): every
     // estimate is bit-identical, because only wrapping differences of stamps are used.
     let cfg = RigConfig::REFERENCE;
@@ -96,7 +97,7 @@ fn microsecond_tick_wrap_changes_nothing() {
 }
 
 #[test]
-fn no_drift_or_windup_over_a_long_run() {
+fn hc13_no_drift_or_windup_over_a_long_run() {
     // Two hours of a settled pendulum (72 M samples; the µs tick wraps once). Per-period sums
     // restart every period and block sums every second, so nothing accumulates:
     // * a still pendulum: the equilibrium after 2 h is bit-identical to the one after 1 min;
@@ -125,7 +126,7 @@ fn no_drift_or_windup_over_a_long_run() {
 }
 
 #[test]
-fn rotation_for_hours_keeps_full_precision() {
+fn hc14_rotation_for_hours_keeps_full_precision() {
     // Unidirectional rotation at 20 rad/s for 3 hours (216 000 rad, 34 000 turns; 1 kHz samples,
     // 10 Hz drive): the period mean is the angle at mid-period to 1e-6 rad, as at the start —
     // angles wrap, they do not lose resolution. Expected: θ(t_mid) in closed form.
@@ -159,4 +160,40 @@ fn rotation_for_hours_keeps_full_precision() {
         }
     }
     assert!(worst < 1e-6, "worst {worst}");
+}
+
+/// The exact phase after n ticks at a constant word w from phase 0: ⌊n·w·2^16/fs⌋ mod 2^32
+/// (the rational n·f/fs turns truncated to 2^-32 turn; module doc of `rig::dds`).
+fn exact_phase(n: u64, w: u32, fs: u32) -> (u32, u32) {
+    let total = u128::from(n) * u128::from(w) * 65_536;
+    (
+        (total / u128::from(fs)) as u32,
+        (total % u128::from(fs)) as u32,
+    )
+}
+
+#[test]
+fn hc10_exact_drive_phase_over_a_billion_periods() {
+    // 50 Hz exactly at fs = 10 kHz: 200 ticks per period; after 10⁹ periods (2·10¹¹ ticks,
+    // 231 days) the phase is back at exactly 0 with no remainder — zero drift.
+    let mut d = Dds::new(10_000, 1);
+    d.start_at(kapitza_core::rig::fixed::Angle::ZERO, 50 << 16);
+    d.advance(50 << 16); // ramp at 1 word per tick lands exactly on the target
+    let ramp_phase = (d.phase().to_turns_u32(), d.remainder());
+    d.advance(200 * 1_000_000_000);
+    assert_eq!((d.phase().to_turns_u32(), d.remainder()), ramp_phase);
+
+    // An incommensurate frequency (49.8473 Hz as the nearest word): the phase after 10⁹ periods
+    // equals the exact rational value, bit for bit (state = (phase, remainder)).
+    let w = kapitza_core::rig::dds::word_from_omega(49.8473 * kapitza_core::math::TAU).unwrap();
+    let mut d = Dds::new(10_000, 1 << 30); // step large enough to jump to w on the first tick
+    d.set_target(w);
+    let n = (1_000_000_000f64 * 10_000.0 / (f64::from(w) / 65_536.0)) as u64;
+    d.advance(n);
+    assert_eq!(
+        (d.phase().to_turns_u32(), d.remainder()),
+        exact_phase(n, w, 10_000)
+    );
+    // And the ω it runs at is the word's, to f64 rounding.
+    assert!((omega_of_word(w) - 49.8473 * kapitza_core::math::TAU).abs() < 1e-4);
 }
