@@ -36,9 +36,9 @@
 //! The tolerances in force, relative and absolute, are at least 100·ε of the number format
 //! (ε = 2.2e-16 for f64, 1.2e-7 for f32): no format can meet a tolerance near its own rounding.
 //! The error estimate cancels stages much larger than the state (on a fast drive |f| ≈ ω|y|),
-//! and its rounding noise, not the solution, then sets the step: f32 at 1e-6 on a 1.6 kHz drive
-//! took 84–190 steps per period against 3–5 at 1e-5 (hard case HC05, docs/hard-cases.md). For
-//! f32 this means tolerances ≥ 1.2e-5; for f64 ≥ 2.2e-14.
+//! and below that its rounding noise, not the solution, sets the step: an f32 run then takes tens
+//! of times the steps for nothing (hard case HC05, docs/hard-cases.md, checks the work per period
+//! at the floor). For f32 this means tolerances ≥ 1.2e-5; for f64 ≥ 2.2e-14.
 
 mod dense;
 #[cfg(test)]

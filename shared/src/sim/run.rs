@@ -495,47 +495,24 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             scheme,
             steps_per_period,
         } => {
-            let (n, h) = fixed_steps(ctx, steps_per_period);
-            let force = AtRest(&sys);
-            let mut done = 0u64;
-            while done < n {
-                let offset = turns.offset();
-                let mut prev = (t, y);
-                let mut extra = 0u64;
-                let x0 = Phase {
-                    q: [y[0]],
-                    v: [y[1]],
-                };
-                // Times of this stretch are t0 + j·h with t0 = done·h: each computed afresh.
-                let sol = symplectic_fixed(scheme, &force, t, x0, h, n - done, |t, x| {
-                    let y = [x.q[0], x.v[0]];
-                    observe(&mut sampler, &sys, prev, (t, y), offset, &mut extra);
-                    prev = (t, y);
-                    stop_if(turns.due(y[0]))
-                });
-                work.add(sol.stats);
-                work.rhs_evals += extra;
-                done += sol.stats.steps;
-                (t, y) = (done as f64 * h, [turns.reduce(sol.y.q[0]), sol.y.v[0]]);
-            }
+            let driver = SymplecticDriver {
+                scheme,
+                force: AtRest(&sys),
+            };
+            let n_h = fixed_steps(ctx, steps_per_period);
+            (t, y) = in_stretches(&driver, &sys, n_h, y, &mut turns, &mut sampler, &mut work);
         }
         Method::Rk4 { steps_per_period } => {
-            let (n, h) = fixed_steps(ctx, steps_per_period);
-            let mut done = 0u64;
-            while done < n {
-                let offset = turns.offset();
-                let mut prev = (t, y);
-                let mut extra = 0u64;
-                let sol = rk4_observe(&sys, t, y, h, n - done, |t, y| {
-                    observe(&mut sampler, &sys, prev, (t, *y), offset, &mut extra);
-                    prev = (t, *y);
-                    stop_if(turns.due(y[0]))
-                });
-                work.add(sol.stats);
-                work.rhs_evals += extra;
-                done += sol.stats.steps;
-                (t, y) = (done as f64 * h, [turns.reduce(sol.y[0]), sol.y[1]]);
-            }
+            let n_h = fixed_steps(ctx, steps_per_period);
+            (t, y) = in_stretches(
+                &Rk4Driver(&sys),
+                &sys,
+                n_h,
+                y,
+                &mut turns,
+                &mut sampler,
+                &mut work,
+            );
         }
     }
     for v in y {
@@ -558,12 +535,93 @@ fn fixed_steps(ctx: &Context, steps_per_period: f64) -> (u64, f64) {
     (n, ctx.t_end / n as f64)
 }
 
-fn stop_if(due: bool) -> Control {
-    if due {
-        Control::Stop
-    } else {
-        Control::Continue
+/// A fixed-step method run from (t, y) for up to n steps, observed after each.
+trait FixedDriver<R: Real> {
+    fn run<O: FnMut(f64, [R; 2]) -> Control>(
+        &self,
+        t: f64,
+        y: [R; 2],
+        h: f64,
+        n: u64,
+        observer: O,
+    ) -> (Stats, [R; 2]);
+}
+
+struct Rk4Driver<'s, S>(&'s S);
+
+impl<R: Real, S: System<2, R>> FixedDriver<R> for Rk4Driver<'_, S> {
+    #[inline(always)]
+    fn run<O: FnMut(f64, [R; 2]) -> Control>(
+        &self,
+        t: f64,
+        y: [R; 2],
+        h: f64,
+        n: u64,
+        mut observer: O,
+    ) -> (Stats, [R; 2]) {
+        let sol = rk4_observe(self.0, t, y, h, n, |t, y| observer(t, *y));
+        (sol.stats, sol.y)
     }
+}
+
+struct SymplecticDriver<F> {
+    scheme: Symplectic,
+    force: F,
+}
+
+impl<R: Real, F: Force<1, R>> FixedDriver<R> for SymplecticDriver<F> {
+    #[inline(always)]
+    fn run<O: FnMut(f64, [R; 2]) -> Control>(
+        &self,
+        t: f64,
+        y: [R; 2],
+        h: f64,
+        n: u64,
+        mut observer: O,
+    ) -> (Stats, [R; 2]) {
+        let x0 = Phase {
+            q: [y[0]],
+            v: [y[1]],
+        };
+        let sol = symplectic_fixed(self.scheme, &self.force, t, x0, h, n, |t, x| {
+            observer(t, [x.q[0], x.v[0]])
+        });
+        (sol.stats, [sol.y.q[0], sol.y.v[0]])
+    }
+}
+
+/// Runs n fixed steps of size h from t = 0 in stretches, each ending when the angle is due for
+/// reduction; the next starts from the reduced state at t = done·h (step times stay t0 + i·h,
+/// computed afresh). Returns where the run ended.
+fn in_stretches<R: Real, S: System<2, R>, D: FixedDriver<R>, Rec: Recorder>(
+    driver: &D,
+    sys: &S,
+    (n, h): (u64, f64),
+    mut y: [R; 2],
+    turns: &mut Turns,
+    sampler: &mut Sampler<'_, Rec>,
+    work: &mut Stats,
+) -> (f64, [R; 2]) {
+    let (mut t, mut done) = (0.0, 0u64);
+    while done < n {
+        let offset = turns.offset();
+        let mut prev = (t, y);
+        let mut extra = 0u64;
+        let (stats, y_end) = driver.run(t, y, h, n - done, |t, y| {
+            observe(sampler, sys, prev, (t, y), offset, &mut extra);
+            prev = (t, y);
+            if turns.due(y[0]) {
+                Control::Stop
+            } else {
+                Control::Continue
+            }
+        });
+        work.add(stats);
+        work.rhs_evals += extra;
+        done += stats.steps;
+        (t, y) = (done as f64 * h, [turns.reduce(y_end[0]), y_end[1]]);
+    }
+    (t, y)
 }
 
 /// Hands a fixed step from `prev` to `next` to the sampler, with its turns added back.
