@@ -1,41 +1,28 @@
 //! Every channel between the tasks, in one place. Each line names its producer → consumer.
 //!
-//! `Signal` holds the latest setting, `Channel` queues messages, `Watch` publishes a value to
-//! readers who want the newest one. The control loop runs in an interrupt, the rest in thread
+//! `Signal` holds the latest setting, `Channel` queues messages, `Pipe` carries a byte stream,
+//! `Watch` publishes a value to readers who want the newest one. The control loop runs in an interrupt, the rest in thread
 //! mode, so everything is guarded by a critical-section mutex.
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex as Cs;
 use embassy_sync::channel::Channel;
+use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_sync::watch::Watch;
-use kapitza_core::link::serve::Effect;
-use kapitza_core::link::{Request, Response, Telemetry};
 use kapitza_core::rig::config::RigConfig;
-use kapitza_core::rig::fixed::Angle;
-
-/// One pendulum-angle sample.
-#[derive(Clone, Copy)]
-pub struct Sample {
-    /// When it was read (µs, wrapping).
-    pub t_us: u32,
-    /// The pendulum angle (the last good one if this read failed).
-    pub angle: Angle,
-    /// The read failed (bus error, parity, or the sensor's error flag).
-    pub failed: bool,
-    /// Taken more than one sample period late.
-    pub late: bool,
-}
+use kapitza_core::station::Sample;
 
 /// pendulum → control: every sample, at the sample rate (a few in flight at most).
 pub static SAMPLES: Channel<Cs, Sample, 8> = Channel::new();
 /// control → pendulum: the sample rate (Hz) of the configuration in use.
 pub static SAMPLE_HZ: Watch<Cs, u32, 1> = Watch::new();
-/// link → control: each valid request, one at a time.
-pub static TO_CONTROL: Channel<Cs, Request, 1> = Channel::new();
-/// control → link: the answer to each `TO_CONTROL` request, and what the link must do with it.
-pub static FROM_CONTROL: Channel<Cs, (Response, Effect), 1> = Channel::new();
-/// control → link: the latest telemetry snapshot.
-pub static TELEMETRY: Watch<Cs, Telemetry, 1> = Watch::new();
+/// link → control: bytes from the laptop, taken at every control tick (1 ms holds 12 bytes at
+/// 115200 baud; the pipe holds 20 ms).
+pub static FROM_LAPTOP: Pipe<Cs, 256> = Pipe::new();
+/// link → control: the UART reported an error (overrun, framing, noise).
+pub static LINE_ERROR: Signal<Cs, ()> = Signal::new();
+/// control → link: frame bytes for the laptop (answers and telemetry).
+pub static TO_LAPTOP: Pipe<Cs, 512> = Pipe::new();
 /// control → tilt: the slew-limited θd, degrees along the mount's travel.
 pub static THETA_D: Signal<Cs, f64> = Signal::new();
 /// safety → control: the e-stop input is active.

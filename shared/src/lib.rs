@@ -16,6 +16,8 @@
 //! | [`rig`] | the microcontroller's logic: drive generator, phase lock, fixed-point estimator, safety — tested on the host and on an emulated Cortex-M4 |
 //! | [`link`] | the serial link: typed messages, COBS + CRC-32C frames, protocol version and compatibility policy, refusal reasons, the rig's side of the conversation |
 //! | [`persist`] | the rig configuration as a checksummed flash record, with the fallback to safe defaults |
+//! | [`station`] | the rig loop: one rig and its link end, hardware-free (samples, control ticks, bytes in → frames out), run by the firmware, the on-target tests and the simulated rig |
+//! | [`simrig`] | the simulated rig: the pendulum's full equation on the crank's actual angle, motor, sensors, servo and e-stop, around a [`station::RigLoop`] |
 //! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
 //!
 //! # Conventions (SPEC §2–3)
@@ -43,7 +45,9 @@ pub mod poly;
 pub mod real;
 pub mod rig;
 pub mod sim;
+pub mod simrig;
 pub mod stability;
+pub mod station;
 
 pub use error::ParamError;
 pub use real::Real;

@@ -156,7 +156,7 @@ fn status() -> impl Strategy<Value = Status> {
     (
         (mode(), proptest::option::of(stop_reason()), any::<bool>()),
         (any::<i32>(), any::<i32>(), any::<i32>(), any::<i32>()),
-        (origin(), any::<u32>(), any::<[u32; 4]>()),
+        (origin(), any::<u32>(), any::<[u32; 6]>()),
     )
         .prop_map(|(a, b, c)| Status {
             mode: a.0,
@@ -173,6 +173,8 @@ fn status() -> impl Strategy<Value = Status> {
                 frames_bad: c.2[1],
                 sensor_errors: c.2[2],
                 overruns: c.2[3],
+                frames_dropped: c.2[4],
+                commands: c.2[5],
             },
         })
 }
@@ -204,7 +206,7 @@ fn telemetry() -> impl Strategy<Value = Telemetry> {
             any::<i32>(),
             any::<i16>(),
         ),
-        (any::<i32>(), any::<i32>(), any::<bool>()),
+        (any::<i32>(), any::<i32>(), any::<bool>(), any::<u32>()),
     )
         .prop_map(|(a, b, c, d)| Telemetry {
             t_us: a.0,
@@ -225,6 +227,7 @@ fn telemetry() -> impl Strategy<Value = Telemetry> {
             current: d.0,
             theta_d_deg: d.1,
             steady: d.2,
+            commands: d.3,
         })
 }
 

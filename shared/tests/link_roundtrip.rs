@@ -105,6 +105,7 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
         current: i32::MIN,
         theta_d_deg: i32::MIN,
         steady: true,
+        commands: u32::MAX,
     };
     let mut s: Status = link_samples::status();
     s.last_stop = Some(StopReason::Fault(kapitza_core::link::message::Fault::Stall));
@@ -120,6 +121,8 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
     s.counters.frames_bad = u32::MAX;
     s.counters.sensor_errors = u32::MAX;
     s.counters.overruns = u32::MAX;
+    s.counters.frames_dropped = u32::MAX;
+    s.counters.commands = u32::MAX;
     vec![
         (
             "set_config",

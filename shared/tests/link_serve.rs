@@ -3,7 +3,7 @@
 
 use kapitza_core::link::convert::{deg_along_travel, from_q16, to_q16};
 use kapitza_core::link::message::{Counters, Fault, Mode};
-use kapitza_core::link::serve::{apply, config_change_allowed, status, telemetry, Command};
+use kapitza_core::link::serve::{apply, config_change_allowed, status, Clock, Command, RigServer};
 use kapitza_core::link::{Reason, Request};
 use kapitza_core::persist::{ConfigOrigin, Fallback};
 use kapitza_core::rig::config::RigConfig;
@@ -244,14 +244,18 @@ fn status_and_telemetry_in_wire_units() {
         current: Amps::from_num(1.5),
     };
     let rep = r.control(1000, &mut m, false);
-    let t = telemetry(
-        1000,
-        &r,
-        &CFG,
-        &rep,
-        Angle::QUARTER_TURN,
-        Amps::from_num(1.5),
+    let mut srv = RigServer::new(
+        CFG,
+        ConfigOrigin::Stored,
+        Tuning::DEFAULT,
+        Angle::ZERO,
+        Clock::single(0, 0),
+        [0, 1, 0],
     );
+    srv.rig = r;
+    srv.counters.commands = 5;
+    let t = srv.telemetry(1000, &rep, Angle::QUARTER_TURN, Amps::from_num(1.5));
+    assert_eq!(t.commands, 5);
     assert_eq!(t.t_us, 1000);
     assert_eq!(t.theta, 1 << 30);
     assert_eq!(t.current, 3 << 15);
@@ -297,7 +301,7 @@ fn reasons_read_well() {
 
 mod server {
     use super::*;
-    use kapitza_core::link::serve::{Effect, RigServer};
+    use kapitza_core::link::serve::Effect;
     use kapitza_core::link::{Response, VersionInfo, WireConfig};
 
     fn server() -> RigServer {
@@ -306,7 +310,7 @@ mod server {
             ConfigOrigin::Defaults(Fallback::Missing),
             Tuning::DEFAULT,
             Angle::ZERO,
-            0,
+            Clock::single(0, 0),
             [1, 2, 3],
         )
     }
@@ -315,7 +319,7 @@ mod server {
     fn answers_every_request() {
         let mut s = server();
         assert_eq!(
-            s.respond(Request::GetVersion, 10, false, 0),
+            s.respond(Request::GetVersion, Clock::single(10, 0), false),
             (
                 Response::Version(VersionInfo {
                     protocol: kapitza_core::link::PROTOCOL_VERSION,
@@ -325,14 +329,18 @@ mod server {
             )
         );
         assert_eq!(
-            s.respond(Request::Telemetry { period_ms: 50 }, 20, false, 0),
+            s.respond(
+                Request::Telemetry { period_ms: 50 },
+                Clock::single(20, 0),
+                false
+            ),
             (Response::Ok, Effect::Telemetry { period_ms: 50 })
         );
         assert_eq!(
-            s.respond(Request::GetConfig, 30, false, 0).0,
+            s.respond(Request::GetConfig, Clock::single(30, 0), false).0,
             Response::Config(CFG.into())
         );
-        let (r, _) = s.respond(Request::GetStatus, 40, true, 77);
+        let (r, _) = s.respond(Request::GetStatus, Clock::single(40, 77), true);
         let Response::Status(st) = r else {
             panic!("{r:?}")
         };
@@ -343,7 +351,10 @@ mod server {
             r: q(2.0),
             theta_d_deg: q(45.0),
         };
-        assert_eq!(s.respond(set, 50, false, 0), (Response::Ok, Effect::None));
+        assert_eq!(
+            s.respond(set, Clock::single(50, 0), false),
+            (Response::Ok, Effect::None)
+        );
         assert_eq!(s.rig.supervisor().mode(), safety::Mode::Running);
     }
 
@@ -356,7 +367,7 @@ mod server {
         let mut bad: WireConfig = new.into();
         bad.control_hz = 0;
         let before = s;
-        let (r, e) = s.respond(Request::SetConfig(bad), 10, false, 0);
+        let (r, e) = s.respond(Request::SetConfig(bad), Clock::single(10, 0), false);
         assert!(
             matches!(r, Response::Refused(Reason::ConfigInvalid { .. })),
             "{r:?}"
@@ -370,17 +381,16 @@ mod server {
                 r: q(1.0),
                 theta_d_deg: 0,
             },
-            20,
+            Clock::single(20, 0),
             false,
-            0,
         );
-        let (r, _) = s.respond(Request::SetConfig(new.into()), 30, false, 0);
+        let (r, _) = s.respond(Request::SetConfig(new.into()), Clock::single(30, 0), false);
         assert_eq!(r, Response::Refused(Reason::WrongMode(Mode::Running)));
         assert_eq!(s.cfg, CFG);
         // Idle: accepted, to be stored; the status follows the store's outcome.
         let mut s = server();
         assert_eq!(
-            s.respond(Request::SetConfig(new.into()), 40, false, 0),
+            s.respond(Request::SetConfig(new.into()), Clock::single(40, 0), false),
             (Response::Ok, Effect::StoreConfig(new))
         );
         assert_eq!(s.cfg, new);

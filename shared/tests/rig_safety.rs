@@ -5,7 +5,9 @@
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::dds::{word_from_omega, Dds};
 use kapitza_core::rig::fixed::{Amps, Angle, RadPerSec};
-use kapitza_core::rig::safety::{Fault, Inputs, Mode, Refusal, Request, StopReason, Supervisor};
+use kapitza_core::rig::safety::{
+    Fault, Inputs, Mode, Output, Refusal, Request, StopReason, Supervisor,
+};
 use proptest::prelude::*;
 
 #[derive(Debug, Clone)]
@@ -90,6 +92,7 @@ proptest! {
                             crank_speed: RadPerSec::saturating_from_num(dds.omega().to_num::<f64>() * crank_frac),
                             ref_omega: dds.omega(),
                             drive_stopped: dds.is_stopped(),
+                            link_us: t,
                         };
                         let out = sup.check(t, &inp);
                         if out.halt { dds.halt() } else { dds.set_target(out.target_word) }
@@ -122,6 +125,11 @@ proptest! {
 }
 
 // ---- scripted cases
+/// One control tick at `t`, the link's clock the same as the rig's.
+fn check(s: &mut Supervisor, t: u32, inp: &Inputs) -> Output {
+    s.check(t, &Inputs { link_us: t, ..*inp })
+}
+
 fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
     Inputs {
         estop: false,
@@ -129,6 +137,7 @@ fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
         crank_speed: RadPerSec::from_num(crank),
         ref_omega: RadPerSec::from_num(ref_omega),
         drive_stopped: stopped,
+        link_us: 0,
     }
 }
 
@@ -167,20 +176,20 @@ fn link_silence_soft_stops_and_never_restarts() {
     let mut t = 0u32;
     for _ in 0..1000 {
         t += 1000;
-        s.check(t, &quiet(300.0, 300.0, false));
+        check(&mut s, t, &quiet(300.0, 300.0, false));
     }
     assert_eq!(s.mode(), Mode::Running); // exactly 1 s of silence is not yet "more than"
     t += 1000;
-    let out = s.check(t, &quiet(300.0, 300.0, false));
+    let out = check(&mut s, t, &quiet(300.0, 300.0, false));
     assert_eq!(s.mode(), Mode::Stopping(StopReason::LinkSilent));
     assert!(out.active && !out.halt && out.target_word == 0); // ramp down, not a halt
     t += 1000;
-    s.check(t, &quiet(0.0, 0.0, true));
+    check(&mut s, t, &quiet(0.0, 0.0, true));
     assert_eq!(s.mode(), Mode::Idle);
     assert_eq!(s.last_stop(), Some(StopReason::LinkSilent));
     s.heard_from_link(t);
     t += 1000;
-    s.check(t, &quiet(0.0, 0.0, true));
+    check(&mut s, t, &quiet(0.0, 0.0, true));
     assert_eq!(s.mode(), Mode::Idle); // no automatic restart
 }
 
@@ -190,14 +199,14 @@ fn estop_halts_at_once_and_latches() {
     s.request(Request::Start { omega: 300.0 }).unwrap();
     let mut inp = quiet(300.0, 300.0, false);
     inp.estop = true;
-    let out = s.check(1000, &inp);
+    let out = check(&mut s, 1000, &inp);
     assert!(out.halt && !out.active);
     assert_eq!(s.mode(), Mode::Faulted(Fault::EStop));
     assert_eq!(
         s.request(Request::ClearFault),
         Err(Refusal::EStopStillActive)
     );
-    s.check(2000, &quiet(0.0, 0.0, true));
+    check(&mut s, 2000, &quiet(0.0, 0.0, true));
     assert_eq!(
         s.request(Request::Start { omega: 1.0 }),
         Err(Refusal::Faulted(Fault::EStop))
@@ -216,7 +225,7 @@ fn drive_angle_slews_within_the_travel() {
     let mut passed_90 = false;
     for _ in 0..7000 {
         t += 1000;
-        let th = s.check(t, &quiet(0.0, 0.0, true)).theta_d.to_deg();
+        let th = check(&mut s, t, &quiet(0.0, 0.0, true)).theta_d.to_deg();
         let th = if th < -10.0 - 1e-6 { th + 360.0 } else { th };
         assert!((-10.0 - 1e-6..=190.0 + 1e-6).contains(&th), "θd {th}");
         passed_90 |= (th - 90.0).abs() < 0.1;
@@ -235,11 +244,11 @@ fn stall_and_over_current_stop_after_their_debounce() {
     for _ in 0..300 {
         t += 1000;
         s.heard_from_link(t);
-        s.check(t, &quiet(100.0, 10.0, false));
+        check(&mut s, t, &quiet(100.0, 10.0, false));
         assert_eq!(s.mode(), Mode::Running, "t = {t}");
     }
     t += 1000;
-    assert!(s.check(t, &quiet(100.0, 10.0, false)).halt);
+    assert!(check(&mut s, t, &quiet(100.0, 10.0, false)).halt);
     assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
     s.request(Request::ClearFault).unwrap();
     s.request(Request::Start { omega: 300.0 }).unwrap();
@@ -248,10 +257,10 @@ fn stall_and_over_current_stop_after_their_debounce() {
     for _ in 0..20 {
         t += 1000;
         s.heard_from_link(t);
-        s.check(t, &inp);
+        check(&mut s, t, &inp);
     }
     assert_eq!(s.mode(), Mode::Running);
     t += 1000;
-    s.check(t, &inp);
+    check(&mut s, t, &inp);
     assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
 }

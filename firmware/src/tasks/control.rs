@@ -1,37 +1,31 @@
-//! The control loop: the rig logic of `kapitza_core::rig` on the real motor, at interrupt
-//! priority.
+//! The control loop: `kapitza_core::station::RigLoop` on the real motor, at interrupt priority.
+//!
+//! Every rig decision is the loop's (when the control tick runs, when the bridge is awake,
+//! requests and their answers, telemetry pacing, counters); this task moves its inputs and
+//! outputs to and from the peripherals and the other tasks:
 //!
 //! ```text
-//! every sample (fs, from the pendulum task):   rig.sample(t, θ): DDS tick, estimator
-//! every fs/fc samples (the control tick):      e-stop in, rig.control: safety check, DDS
-//!                                              target, phase lock → duty; bridge on only while
-//!                                              running or stopping; θd to the servo, heartbeat
-//!                                              to the watchdog, telemetry (every 10th tick),
-//!                                              one link request answered (RigServer::respond)
+//! every sample (from the pendulum task):  loop.sample
+//! when it says a control tick is due:     bytes from the link task → loop.receive (answered now)
+//!                                         loop.control(crank, current, e-stop) → duty
+//!                                         bridge enable, θd to the servo, a configuration to
+//!                                         store, heartbeat to the watchdog
+//!                                         loop.transmit → frame bytes to the link task
 //! ```
-//! The loop is clocked by the samples, so the DDS advances exactly once per sample. The
-//! estimator runs inside `rig.sample` because it needs each sample with the drive phase of the
-//! same tick; a separate task would need a queue of (t, θ, φ) at 10 kHz for nothing.
-//! Requests are answered here, between two ticks, by `kapitza_core::link::serve::RigServer`:
-//! commands all or nothing, a new configuration only while idle.
+//! The loop is clocked by the samples, so the DDS advances exactly once per sample and the
+//! estimator sees each sample with the drive phase of the same tick.
 
-use kapitza_core::link::convert::deg_along_travel;
-use kapitza_core::link::serve::{self, Effect, RigServer};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
-use kapitza_core::rig::estimator::Tuning;
 use kapitza_core::rig::fixed::{Amps, Angle, Duty};
 use kapitza_core::rig::phase_lock::Motor;
-use kapitza_core::rig::safety::Mode;
+use kapitza_core::station::RigLoop;
 
 use crate::board::{Drive, AMPS_PER_COUNT_Q16, CRANK_COUNTS};
 use crate::channels::{
-    CONFIG_SAVED, ESTOP, FROM_CONTROL, HEARTBEAT, SAMPLES, SAMPLE_HZ, SAVE_CONFIG, TELEMETRY,
-    THETA_D, TO_CONTROL,
+    CONFIG_SAVED, ESTOP, FROM_LAPTOP, HEARTBEAT, LINE_ERROR, SAMPLES, SAMPLE_HZ, SAVE_CONFIG,
+    THETA_D, TO_LAPTOP,
 };
-
-/// Telemetry is published every this many control ticks (100 Hz at fc = 1 kHz).
-const TELEMETRY_EVERY: u32 = 10;
 
 /// This firmware's version, from its Cargo.toml.
 const FIRMWARE: [u16; 3] = [
@@ -54,7 +48,6 @@ const fn parse_u16(s: &str) -> u16 {
 /// The crank motor behind the phase lock's three-method trait.
 struct Hw<'a> {
     drive: &'a mut Drive,
-    current: Amps,
 }
 
 impl Motor for Hw<'_> {
@@ -64,16 +57,11 @@ impl Motor for Hw<'_> {
     }
     fn current(&mut self) -> Amps {
         let counts = i32::from(self.drive.current_counts());
-        self.current = Amps::from_bits(counts.saturating_mul(AMPS_PER_COUNT_Q16));
-        self.current
+        Amps::from_bits(counts.saturating_mul(AMPS_PER_COUNT_Q16))
     }
     fn set_duty(&mut self, duty: Duty) {
         self.drive.set_duty(duty.to_bits());
     }
-}
-
-fn samples_per_control(cfg: &RigConfig) -> u32 {
-    cfg.derived().samples_per_control.max(1)
 }
 
 #[embassy_executor::task]
@@ -85,65 +73,41 @@ pub async fn run(mut drive: Drive, cfg: RigConfig, origin: ConfigOrigin) {
         cfg.limits.drive_angle_max_deg,
     );
     let t0 = embassy_time::Instant::now().as_micros() as u32;
-    let theta0 = Angle::from_deg(theta0_deg);
-    let mut srv = RigServer::new(cfg, origin, Tuning::DEFAULT, theta0, t0, FIRMWARE);
-    THETA_D.signal(theta0_deg);
-    let mut last_theta_d = theta0;
-    let mut per_control = samples_per_control(&cfg);
-    let mut k = 0u32;
-    let mut ticks = 0u32;
+    let mut rig = RigLoop::new(cfg, origin, Angle::from_deg(theta0_deg), t0, FIRMWARE);
+    let mut inbox = [0u8; 64];
+    let mut outbox = [0u8; 128];
     drive.enable(false);
     loop {
         let s = SAMPLES.receive().await;
-        let c = &mut srv.counters;
-        if s.failed {
-            c.sensor_errors = c.sensor_errors.saturating_add(1);
-        }
-        if s.late {
-            c.overruns = c.overruns.saturating_add(1);
-        }
-        srv.rig.sample(s.t_us, s.angle);
-        k += 1;
-        if k < per_control {
+        if !rig.sample(s) {
             continue;
         }
-        k = 0;
-        ticks = ticks.wrapping_add(1);
         let t = s.t_us;
-
-        // No e-stop reading yet counts as pressed: the rig cannot start blind.
-        let estop = ESTOP.try_get().unwrap_or(true);
-        let mut hw = Hw {
-            drive: &mut drive,
-            current: Amps::ZERO,
-        };
-        let rep = srv.rig.control(t, &mut hw, estop);
-        let current = hw.current;
-        drive.enable(matches!(rep.mode, Mode::Running | Mode::Stopping(_)));
-        if rep.theta_d != last_theta_d {
-            last_theta_d = rep.theta_d;
-            let min = srv.cfg.limits.drive_angle_min_deg;
-            THETA_D.signal(deg_along_travel(rep.theta_d, min));
+        while let Ok(n) = FROM_LAPTOP.try_read(&mut inbox) {
+            rig.receive(&inbox[..n], t);
         }
-        HEARTBEAT.signal(());
-        if ticks.is_multiple_of(TELEMETRY_EVERY) {
-            let tm = serve::telemetry(t, &srv.rig, &srv.cfg, &rep, s.angle, current);
-            TELEMETRY.sender().send(tm);
+        if LINE_ERROR.try_take().is_some() {
+            rig.line_error();
         }
         if let Some(ok) = CONFIG_SAVED.try_take() {
-            srv.config_saved(ok);
+            rig.config_saved(ok);
         }
-        if let Ok(req) = TO_CONTROL.try_receive() {
-            let uptime_ms = embassy_time::Instant::now().as_millis() as u32;
-            let (resp, effect) = srv.respond(req, t, estop, uptime_ms);
-            if let Effect::StoreConfig(new) = effect {
-                per_control = samples_per_control(&new);
-                k = 0;
-                SAMPLE_HZ.sender().send(new.sample_hz);
-                SAVE_CONFIG.signal(new);
-            }
-            // The link waits for each answer, so there is room.
-            let _ = FROM_CONTROL.try_send((resp, effect));
+        let tick = rig.control(t, &mut Hw { drive: &mut drive }, ESTOP.try_get());
+        drive.enable(tick.bridge);
+        if let Some(deg) = tick.servo_deg {
+            THETA_D.signal(deg);
+        }
+        if let Some(new) = tick.store {
+            SAMPLE_HZ.sender().send(new.sample_hz);
+            SAVE_CONFIG.signal(new);
+        }
+        HEARTBEAT.signal(());
+        // As many frame bytes as the link's pipe takes now; the rest wait in the loop.
+        let room = TO_LAPTOP.free_capacity().min(outbox.len());
+        let n = rig.transmit(&mut outbox[..room]);
+        if n > 0 {
+            // The room was measured above and only this task writes: it all fits.
+            let _ = TO_LAPTOP.try_write(&outbox[..n]);
         }
     }
 }

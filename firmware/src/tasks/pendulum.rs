@@ -15,7 +15,9 @@ use embassy_time::{Duration, Instant, Ticker};
 use kapitza_core::rig::fixed::Angle;
 
 use crate::board::{PendulumBus, PENDULUM_SIGN, PENDULUM_ZERO};
-use crate::channels::{Sample, SAMPLES, SAMPLE_HZ};
+use kapitza_core::station::Sample;
+
+use crate::channels::{SAMPLES, SAMPLE_HZ};
 
 /// Read ANGLECOM (0x3FFF) with the read bit and even parity.
 const READ_ANGLE: u16 = 0xFFFF;

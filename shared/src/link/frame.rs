@@ -171,12 +171,18 @@ fn strict<'a, M: serde::Deserialize<'a>>(payload: &'a [u8]) -> Result<M, Reason>
 /// The rig's side: what a checked frame asks for. `GetVersion` is recognised whatever the
 /// frame's version; every other request needs this protocol version.
 pub fn decode_request(frame: &Frame<'_>) -> Result<Request, Reason> {
+    decode_request_as(frame, PROTOCOL_VERSION)
+}
+
+/// [`decode_request`] for a rig that speaks protocol `version` (a simulated rig made to speak
+/// another version, to test what a host does about version skew).
+pub fn decode_request_as(frame: &Frame<'_>, version: u8) -> Result<Request, Reason> {
     if frame.payload == GET_VERSION_PAYLOAD {
         return Ok(Request::GetVersion);
     }
-    if frame.header.version != PROTOCOL_VERSION {
+    if frame.header.version != version {
         return Err(Reason::VersionMismatch {
-            rig: PROTOCOL_VERSION,
+            rig: version,
             frame: frame.header.version,
         });
     }

@@ -133,6 +133,13 @@ pub struct Counters {
     pub sensor_errors: u32,
     /// Pendulum samples taken more than half a period late.
     pub overruns: u32,
+    /// Frames the rig had to drop because the line was not taking them (telemetry first; an
+    /// answer only when the laptop sends faster than the line carries the answers back).
+    pub frames_dropped: u32,
+    /// Commands carried out (`SetDrive`, `Stop`, `ClearFault`, `SetConfig` answered `Ok`).
+    /// Telemetry carries it too, so a host can tell a snapshot taken after its command from
+    /// one taken before.
+    pub commands: u32,
 }
 
 /// One snapshot of the control loop and the estimator.
@@ -169,6 +176,8 @@ pub struct Telemetry {
     pub theta_d_deg: Q16,
     /// The drive is at its set ω and θd at its target: the estimator is measuring.
     pub steady: bool,
+    /// [`Counters::commands`] when the snapshot was taken.
+    pub commands: u32,
 }
 
 /// The supervisor's mode ([`crate::rig::safety::Mode`]).

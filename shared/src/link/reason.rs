@@ -35,8 +35,6 @@ pub enum Reason {
     VersionMismatch { rig: u8, frame: u8 },
     /// Longer than the largest frame of this protocol version.
     TooLong,
-    /// The rig could not take the command now (its queue was full); send it again.
-    Busy,
 
     // --- command level: the rig refused ---
     /// R is negative or not a number.
@@ -138,7 +136,6 @@ impl Reason {
             Self::UnknownMessage => 4,
             Self::VersionMismatch { .. } => 5,
             Self::TooLong => 6,
-            Self::Busy => 7,
             Self::RInvalid { .. } => 16,
             Self::OmegaInvalid => 17,
             Self::OmegaAboveLimit { .. } => 18,
@@ -174,7 +171,6 @@ impl fmt::Display for Reason {
                 "protocol version {frame} in the frame, but the rig speaks version {rig}"
             ),
             Self::TooLong => f.write_str("frame longer than any message of this protocol"),
-            Self::Busy => f.write_str("rig busy, command not taken; send it again"),
             Self::RInvalid { requested } => {
                 write!(f, "R = {} is not a number >= 0", q16(requested))
             }

@@ -1,6 +1,6 @@
 //! The rig's side of the link, free of hardware: applying a command to a [`Rig`] all or nothing,
 //! building the status and telemetry messages from it, and [`RigServer`], which answers every
-//! request. The firmware's control loop owns a `RigServer`; a simulated rig can own the same.
+//! request. [`crate::station::RigLoop`] owns one and frames its answers.
 
 use super::convert::{deg_along_travel, from_q16, to_q16};
 use super::message::{Counters, Request, Response, Status, Telemetry, VersionInfo, WireConfig};
@@ -111,42 +111,6 @@ pub fn status(
     }
 }
 
-/// The telemetry message for one control tick: its report, the latest pendulum sample and
-/// motor current, and the estimator's state.
-pub fn telemetry(
-    t_us: u32,
-    rig: &Rig,
-    cfg: &RigConfig,
-    report: &ControlReport,
-    theta: Angle,
-    current: Amps,
-) -> Telemetry {
-    let e = rig.estimate();
-    Telemetry {
-        t_us,
-        mode: report.mode.into(),
-        theta: theta.to_bits(),
-        phi: e.phi.to_bits(),
-        phi_rate: e.phi_rate.to_bits(),
-        omega_p: e.omega_p.map(|x| x.to_bits()),
-        sigma: e.sigma.map(|x| x.to_bits()),
-        settled: e.settled,
-        equilibrium: e.equilibrium.map(Angle::to_bits),
-        r: e.r.map(|(r, m)| (r.to_bits(), m.into())),
-        periods: e.periods,
-        omega: report.ref_omega.to_bits(),
-        crank_speed: report.crank_speed.to_bits(),
-        phase_error: report.phase_error.to_bits(),
-        duty: report.duty.to_bits(),
-        current: current.to_bits(),
-        theta_d_deg: to_q16(deg_along_travel(
-            report.theta_d,
-            cfg.limits.drive_angle_min_deg,
-        )),
-        steady: report.steady,
-    }
-}
-
 /// What the caller must do besides sending the response.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Effect {
@@ -159,9 +123,34 @@ pub enum Effect {
     },
 }
 
+/// When a request is answered: the rig's clock, the link's clock and the uptime.
+///
+/// On the rig the two clocks are one; a simulated rig running faster than real time keeps the
+/// link's clock on wall time, so a link-silence timeout of 1 s stays 1 s of the laptop's time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Clock {
+    /// The rig's µs clock (wrapping), as its samples are stamped.
+    pub rig_us: u32,
+    /// The link's µs clock (wrapping), see [`crate::rig::safety::Inputs::link_us`].
+    pub link_us: u32,
+    /// Milliseconds since power-up, for the status.
+    pub uptime_ms: u32,
+}
+
+impl Clock {
+    /// One clock for both, as on the rig.
+    pub const fn single(t_us: u32, uptime_ms: u32) -> Self {
+        Self {
+            rig_us: t_us,
+            link_us: t_us,
+            uptime_ms,
+        }
+    }
+}
+
 /// The rig's side of the conversation in one place: a [`Rig`] with its configuration, where
-/// that came from, and the loop's counters, answering every [`Request`]. The firmware's control
-/// loop owns one; a simulated rig can own one too.
+/// that came from, and the loop's counters, answering every [`Request`]. Owned by
+/// [`crate::station::RigLoop`], which frames the answers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigServer {
     pub rig: Rig,
@@ -171,6 +160,9 @@ pub struct RigServer {
     pub tuning: crate::rig::estimator::Tuning,
     /// This firmware's version, reported by `GetVersion`.
     pub firmware: [u16; 3],
+    /// The protocol version reported by `GetVersion`: [`super::PROTOCOL_VERSION`] unless a
+    /// simulated rig is made to speak another one.
+    pub protocol: u8,
 }
 
 impl RigServer {
@@ -180,37 +172,30 @@ impl RigServer {
         origin: ConfigOrigin,
         tuning: crate::rig::estimator::Tuning,
         theta_d0: Angle,
-        now_us: u32,
+        at: Clock,
         firmware: [u16; 3],
     ) -> Self {
+        let mut rig = Rig::new(&cfg, &tuning, theta_d0, at.rig_us);
+        rig.link_message(at.link_us);
         Self {
-            rig: Rig::new(&cfg, &tuning, theta_d0, now_us),
+            rig,
             cfg,
             origin,
             counters: Counters::default(),
             tuning,
             firmware,
+            protocol: super::PROTOCOL_VERSION,
         }
     }
 
     /// Answers one request (decoded from a valid frame, so it also counts as the link being
-    /// alive). `estop` is the e-stop line now; `uptime_ms` goes into the status.
-    pub fn respond(
-        &mut self,
-        req: Request,
-        now_us: u32,
-        estop: bool,
-        uptime_ms: u32,
-    ) -> (Response, Effect) {
-        self.rig.link_message(now_us);
-        let done = |r: Result<(), Reason>| match r {
-            Ok(()) => Response::Ok,
-            Err(reason) => Response::Refused(reason),
-        };
-        match req {
+    /// alive). `estop` is the e-stop line now.
+    pub fn respond(&mut self, req: Request, at: Clock, estop: bool) -> (Response, Effect) {
+        self.rig.link_message(at.link_us);
+        let (resp, effect) = match req {
             Request::GetVersion => (
                 Response::Version(VersionInfo {
-                    protocol: super::PROTOCOL_VERSION,
+                    protocol: self.protocol,
                     firmware: self.firmware,
                 }),
                 Effect::None,
@@ -221,7 +206,7 @@ impl RigServer {
                     &self.cfg,
                     estop,
                     self.origin,
-                    uptime_ms,
+                    at.uptime_ms,
                     self.counters,
                 )),
                 Effect::None,
@@ -231,26 +216,85 @@ impl RigServer {
                     Some(c) => apply(&mut self.rig, &self.cfg, c),
                     None => Err(Reason::UnknownMessage),
                 };
-                (done(r), Effect::None)
+                match r {
+                    Ok(()) => (Response::Ok, Effect::None),
+                    Err(reason) => (Response::Refused(reason), Effect::None),
+                }
             }
-            Request::SetConfig(w) => match self.set_config(w, now_us) {
-                Ok(cfg) => (Response::Ok, Effect::StoreConfig(cfg)),
+            Request::SetConfig(w) => match self.set_config(w, at) {
+                Ok(Some(cfg)) => (Response::Ok, Effect::StoreConfig(cfg)),
+                Ok(None) => (Response::Ok, Effect::None),
                 Err(reason) => (Response::Refused(reason), Effect::None),
             },
             Request::GetConfig => (Response::Config(self.cfg.into()), Effect::None),
             Request::Telemetry { period_ms } => (Response::Ok, Effect::Telemetry { period_ms }),
+        };
+        let command = matches!(
+            req,
+            Request::SetDrive { .. } | Request::Stop | Request::ClearFault | Request::SetConfig(_)
+        );
+        if command && resp == Response::Ok {
+            self.counters.commands = self.counters.commands.wrapping_add(1);
         }
+        (resp, effect)
     }
 
     /// A new configuration: valid, and the rig idle; the rig restarts on it with θd kept.
-    fn set_config(&mut self, w: WireConfig, now_us: u32) -> Result<RigConfig, Reason> {
+    /// The one already in use and in flash is accepted as it is (`None`: nothing to store, so
+    /// a repeated `SetConfig` never wears the flash page).
+    fn set_config(&mut self, w: WireConfig, at: Clock) -> Result<Option<RigConfig>, Reason> {
         let cfg = w.to_valid()?;
+        let in_flash = matches!(
+            self.origin,
+            ConfigOrigin::Stored | ConfigOrigin::Received { saved: true }
+        );
+        if cfg == self.cfg && in_flash {
+            return Ok(None);
+        }
         config_change_allowed(&self.rig)?;
         let theta_d = self.rig.supervisor().theta_d();
-        self.rig = Rig::new(&cfg, &self.tuning, theta_d, now_us);
+        self.rig = Rig::new(&cfg, &self.tuning, theta_d, at.rig_us);
+        self.rig.link_message(at.link_us);
         self.cfg = cfg;
         self.origin = ConfigOrigin::Received { saved: false };
-        Ok(cfg)
+        Ok(Some(cfg))
+    }
+
+    /// The telemetry message for one control tick: its report, the latest pendulum sample and
+    /// motor current, and the estimator's state.
+    pub fn telemetry(
+        &self,
+        t_us: u32,
+        report: &ControlReport,
+        theta: Angle,
+        current: Amps,
+    ) -> Telemetry {
+        let (rig, cfg) = (&self.rig, &self.cfg);
+        let e = rig.estimate();
+        Telemetry {
+            t_us,
+            mode: report.mode.into(),
+            theta: theta.to_bits(),
+            phi: e.phi.to_bits(),
+            phi_rate: e.phi_rate.to_bits(),
+            omega_p: e.omega_p.map(|x| x.to_bits()),
+            sigma: e.sigma.map(|x| x.to_bits()),
+            settled: e.settled,
+            equilibrium: e.equilibrium.map(Angle::to_bits),
+            r: e.r.map(|(r, m)| (r.to_bits(), m.into())),
+            periods: e.periods,
+            omega: report.ref_omega.to_bits(),
+            crank_speed: report.crank_speed.to_bits(),
+            phase_error: report.phase_error.to_bits(),
+            duty: report.duty.to_bits(),
+            current: current.to_bits(),
+            theta_d_deg: to_q16(deg_along_travel(
+                report.theta_d,
+                cfg.limits.drive_angle_min_deg,
+            )),
+            steady: report.steady,
+            commands: self.counters.commands,
+        }
     }
 
     /// The store that [`Effect::StoreConfig`] asked for finished (`ok`: it reached flash).

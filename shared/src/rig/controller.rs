@@ -52,7 +52,8 @@ impl Rig {
         }
     }
 
-    /// A valid message arrived from the laptop (keeps the link alive).
+    /// A valid message arrived from the laptop (keeps the link alive); `now_us` on the link's
+    /// clock.
     pub fn link_message(&mut self, now_us: u32) {
         self.sup.heard_from_link(now_us);
     }
@@ -70,8 +71,19 @@ impl Rig {
         psi
     }
 
-    /// Control tick.
+    /// Control tick, the link's clock the same as the rig's.
     pub fn control<M: Motor>(&mut self, t_us: u32, motor: &mut M, estop: bool) -> ControlReport {
+        self.control_at(t_us, t_us, motor, estop)
+    }
+
+    /// Control tick, with the link's clock apart ([`super::safety::Inputs::link_us`]).
+    pub fn control_at<M: Motor>(
+        &mut self,
+        t_us: u32,
+        link_us: u32,
+        motor: &mut M,
+        estop: bool,
+    ) -> ControlReport {
         let crank = motor.crank_angle();
         let inputs = Inputs {
             estop,
@@ -79,6 +91,7 @@ impl Rig {
             crank_speed: self.lock.crank_speed(),
             ref_omega: self.dds.omega(),
             drive_stopped: self.dds.is_stopped(),
+            link_us,
         };
         let out = self.sup.check(t_us, &inputs);
         if out.halt {

@@ -135,6 +135,10 @@ pub struct Inputs {
     pub ref_omega: RadPerSec,
     /// The drive generator has reached zero frequency.
     pub drive_stopped: bool,
+    /// The link's clock now (µs, wrapping), the clock [`Supervisor::heard_from_link`] is given.
+    /// On the rig it is `now_us`; a simulated rig running faster than real time gives wall time,
+    /// so the link-silence timeout stays what it says.
+    pub link_us: u32,
 }
 
 /// What the drive may do after this tick.
@@ -226,7 +230,7 @@ impl Supervisor {
         self.theta_target
     }
 
-    /// A valid message arrived from the laptop.
+    /// A valid message arrived from the laptop (`now_us` on the link's clock, [`Inputs::link_us`]).
     pub fn heard_from_link(&mut self, now_us: u32) {
         self.last_link_us = now_us;
     }
@@ -338,7 +342,7 @@ impl Supervisor {
             self.stall_since = None;
         }
         // Link silence: soft stop.
-        if self.mode == Mode::Running && elapsed_us(self.last_link_us, now_us) > self.link_us {
+        if self.mode == Mode::Running && elapsed_us(self.last_link_us, inp.link_us) > self.link_us {
             self.mode = Mode::Stopping(StopReason::LinkSilent);
             self.target_word = 0;
         }

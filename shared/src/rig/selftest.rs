@@ -210,6 +210,7 @@ fn safety_script() -> u64 {
                 crank_speed: RadPerSec::from_num(if i == 7 { 5 } else { 100 }),
                 ref_omega: RadPerSec::from_num(100),
                 drive_stopped: k > 600,
+                link_us: t,
             };
             let o = s.check(t, &inp);
             d.u32(u32::from(o.active) | (u32::from(o.halt) << 1));

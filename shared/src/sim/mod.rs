@@ -9,6 +9,7 @@
 //! | [`classify`] | the outcome from stroboscopic samples |
 //! | [`sampling`] | strobes, period means, output and sensor samples between steps |
 //! | [`sensor`] | the pivot encoder: sampled, noisy, quantised |
+//! | [`noise`] | seeded, reproducible uniform and Gaussian noise |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
@@ -19,6 +20,7 @@ pub mod eom;
 pub mod fidelity;
 mod friction;
 mod lyapunov;
+pub mod noise;
 pub mod run;
 pub mod sampling;
 pub mod scene;

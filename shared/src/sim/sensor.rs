@@ -3,9 +3,9 @@
 //! ```text
 //! measured = q(θ + n),   n ~ N(0, σ²),   q(x) = round(x · 2^bits / 2π) · 2π / 2^bits, wrapped to (−π, π]
 //! ```
-//! Noise comes from a seeded generator (xorshift64*, Vigna 2016, with Box–Muller), so a run is
-//! reproducible to the bit.
+//! Noise comes from a seeded generator ([`Noise`]), so a run is reproducible to the bit.
 
+use super::noise::Noise;
 use super::scene::Sensor;
 use crate::math;
 
@@ -13,16 +13,14 @@ use crate::math;
 #[derive(Debug, Clone)]
 pub struct Encoder {
     spec: Sensor,
-    state: u64,
-    spare: Option<f64>,
+    noise: Noise,
 }
 
 impl Encoder {
     pub fn new(spec: Sensor, seed: u64) -> Self {
         Self {
             spec,
-            state: seed.max(1),
-            spare: None,
+            noise: Noise::new(seed),
         }
     }
 
@@ -33,30 +31,10 @@ impl Encoder {
 
     /// What the encoder reports for the true angle θ (rad).
     pub fn measure(&mut self, theta: f64) -> f64 {
-        let noisy = theta + self.spec.noise * self.gaussian();
+        let noisy = theta + self.spec.noise * self.noise.gaussian();
         let counts = libm::ldexp(1.0, self.spec.bits as i32);
         let lsb = math::TAU / counts;
         math::wrap_pi(libm::round(noisy / lsb) * lsb)
-    }
-
-    fn uniform(&mut self) -> f64 {
-        // xorshift64*: 64-bit state, top 53 bits of the scrambled output as a uniform in (0, 1).
-        self.state ^= self.state >> 12;
-        self.state ^= self.state << 25;
-        self.state ^= self.state >> 27;
-        let x = self.state.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn gaussian(&mut self) -> f64 {
-        if let Some(z) = self.spare.take() {
-            return z;
-        }
-        let (u, v) = (self.uniform(), self.uniform());
-        let r = math::sqrt(-2.0 * libm::log(u));
-        let (s, c) = math::sin_cos(math::TAU * v);
-        self.spare = Some(r * s);
-        r * c
     }
 }
 

@@ -36,6 +36,8 @@ pub fn status() -> Status {
             frames_bad: 3,
             sensor_errors: 0,
             overruns: 1,
+            frames_dropped: 2,
+            commands: 77,
         },
     }
 }
@@ -60,6 +62,7 @@ pub fn telemetry() -> Telemetry {
         current: 98_304,
         theta_d_deg: 180 << 16,
         steady: true,
+        commands: 4_000_000_000,
     }
 }
 
@@ -165,7 +168,6 @@ pub fn reasons() -> Vec<(&'static str, Reason)> {
             Reason::VersionMismatch { rig: 1, frame: 2 },
         ),
         ("refused_too_long", Reason::TooLong),
-        ("refused_busy", Reason::Busy),
         ("refused_r_invalid", Reason::RInvalid { requested: -65536 }),
         ("refused_omega_invalid", Reason::OmegaInvalid),
         (

@@ -1,0 +1,334 @@
+//! The simulated rig: the physics of a real bench around the same [`RigLoop`] the firmware
+//! runs, stepped one pendulum sample at a time. The host tool serves it on a pseudo-terminal or
+//! runs it in-process when no hardware is attached; the end-to-end tests drive it.
+//!
+//! | module | concept |
+//! |---|---|
+//! | [`plant`] | the pendulum driven by the crank's actual angle, the DC motor, friction |
+//!
+//! ```text
+//! every sample period h = 1/fs:
+//!   sensors → Sample (14-bit absolute angle with noise, the sensor's own zero and sign)
+//!   RigLoop::sample; when due RigLoop::control(crank counts, motor current, e-stop)
+//!                    → duty (0 while the bridge sleeps), θd for the servo
+//!   servo slews the mount toward θd at its own rate;  plant: one RK4 step of h
+//! ```
+//! The true parameters ([`Params`]) may differ from the configuration the rig was given, the
+//! way a real rig differs from what was typed in: the hidden ones (sensor zero and sign, crank
+//! and motor direction, servo offset, current offset) are those calibration must find.
+//! Everything is deterministic under [`Params::seed`].
+
+pub mod plant;
+
+use crate::integrate::{rk4_step, Stats};
+use crate::link::message::Counters;
+use crate::math;
+use crate::model::Geometry;
+use crate::persist::ConfigOrigin;
+use crate::rig::config::RigConfig;
+use crate::rig::fixed::{Amps, Angle, Duty};
+use crate::rig::phase_lock::Motor;
+use crate::sim::noise::Noise;
+use crate::station::{RigLoop, Sample, Tick};
+use plant::{MotorModel, Plant};
+
+/// Crank encoder counts per turn (a power of two, as the firmware's board constant).
+pub const CRANK_COUNTS: u32 = 4096;
+/// Pendulum sensor bits per turn (AS5047P: 14).
+pub const SENSOR_BITS: u32 = 14;
+
+/// The true rig: what the bench really is, whatever the configuration says.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Params {
+    pub geometry: Geometry,
+    pub gravity: f64,
+    /// The crank radius A (m).
+    pub amplitude: f64,
+    /// The slider-crank's connecting rod b (m), for the second harmonic; `None`: a pure sine.
+    pub connecting_rod: Option<f64>,
+    /// Viscous damping c (1/s) and Coulomb friction μ (rad/s²).
+    pub damping: f64,
+    pub coulomb: f64,
+    pub motor: MotorModel,
+    /// Sensor noise (rad, standard deviation) before the 14-bit quantisation.
+    pub sensor_noise: f64,
+    /// Where the sensor reads zero (rad from hanging) and +1/−1 for its direction.
+    pub sensor_zero: f64,
+    pub sensor_sign: f64,
+    /// +1/−1: the crank encoder counts with the crank, or against it (swapped channels).
+    pub crank_sign: f64,
+    /// The servo's speed (deg/s) and the mount's true angle minus the commanded one (deg).
+    pub servo_rate_deg: f64,
+    pub servo_offset_deg: f64,
+    /// The current sensor's reading at zero current (A).
+    pub current_offset: f64,
+    /// The pendulum's angle (rad) at power-up, at rest.
+    pub theta0: f64,
+    pub seed: u64,
+}
+
+impl Params {
+    /// The demo rod of SPEC §4 (L = 0.25 m, A = 12.7 mm), lightly damped (Q ≈ 25), on the
+    /// default motor, a quiet sensor (0.02°) and a fast servo, hanging at rest.
+    pub const DEMO: Self = Self {
+        geometry: Geometry::Rod { length: 0.25 },
+        gravity: 9.81,
+        amplitude: 0.0127,
+        connecting_rod: None,
+        damping: 0.3,
+        coulomb: 0.0,
+        motor: MotorModel::DEFAULT,
+        sensor_noise: 3.5e-4,
+        sensor_zero: 0.0,
+        sensor_sign: 1.0,
+        crank_sign: 1.0,
+        servo_rate_deg: 300.0,
+        servo_offset_deg: 0.0,
+        current_offset: 0.0,
+        theta0: 0.0,
+        seed: 1,
+    };
+
+    /// The rig configuration a careful user would type for this rig: the reference limits and
+    /// motor tuning with this rig's own pendulum, stroke and gravity.
+    pub fn configured(&self) -> RigConfig {
+        RigConfig {
+            amplitude: self.amplitude,
+            geometry: self.geometry,
+            gravity: self.gravity,
+            ..RigConfig::REFERENCE
+        }
+    }
+}
+
+/// The true state, for the truth log and the tests (never seen by the rig).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Truth {
+    /// Seconds since power-up.
+    pub t: f64,
+    /// Pendulum angle (rad, unwrapped) and rate (rad/s).
+    pub theta: f64,
+    pub theta_rate: f64,
+    /// Crank angle (rad) and speed (rad/s).
+    pub crank: f64,
+    pub crank_speed: f64,
+    /// The mount's true drive angle (deg).
+    pub theta_d_deg: f64,
+    pub duty: f64,
+}
+
+/// A whole simulated rig.
+#[derive(Debug, Clone)]
+pub struct SimRig {
+    params: Params,
+    rig: RigLoop,
+    plant: Plant,
+    y: [f64; 4],
+    noise: Noise,
+    /// Samples since power-up.
+    k: u64,
+    /// The servo's commanded position (deg along the travel).
+    servo_target_deg: f64,
+    servo_deg: f64,
+    pub estop: bool,
+    last_tick: Option<Tick>,
+    stats: Stats,
+}
+
+impl SimRig {
+    /// The rig `params` configured with `cfg` (validated by the caller, as flash would hold it),
+    /// powered up at its clock's 0, the mount at θd = 0.
+    pub fn new(params: Params, cfg: RigConfig, origin: ConfigOrigin, firmware: [u16; 3]) -> Self {
+        let ell = params.geometry.equivalent_length();
+        let second = params
+            .connecting_rod
+            .map_or(0.0, |b| params.amplitude * params.amplitude / (4.0 * b));
+        let servo0 = 0f64.clamp(
+            cfg.limits.drive_angle_min_deg,
+            cfg.limits.drive_angle_max_deg,
+        );
+        let plant = Plant {
+            omega0_sq: params.gravity / ell,
+            ell,
+            amplitude: params.amplitude,
+            second,
+            damping: params.damping,
+            coulomb: params.coulomb,
+            theta_d: math::to_rad(servo0 + params.servo_offset_deg),
+            motor: params.motor,
+            duty: 0.0,
+            jammed: false,
+        };
+        Self {
+            rig: RigLoop::new(cfg, origin, Angle::from_deg(servo0), 0, firmware),
+            plant,
+            y: [params.theta0, 0.0, 0.0, 0.0],
+            noise: Noise::new(params.seed),
+            k: 0,
+            servo_target_deg: servo0,
+            servo_deg: servo0,
+            estop: false,
+            last_tick: None,
+            stats: Stats::default(),
+            params,
+        }
+    }
+
+    /// The same rig speaking link protocol `version`: for tests of version skew
+    /// ([`RigLoop::speaking`]).
+    pub fn speaking(mut self, version: u8) -> Self {
+        self.rig = self.rig.speaking(version);
+        self
+    }
+
+    /// Seconds since power-up.
+    pub fn seconds(&self) -> f64 {
+        self.k as f64 / f64::from(self.rig.sample_hz())
+    }
+
+    /// The rig's µs clock (wrapping).
+    pub fn t_us(&self) -> u32 {
+        (self.k * 1_000_000 / u64::from(self.rig.sample_hz())) as u32
+    }
+
+    /// One sample period. `link_us` is the link's clock; `None`: the rig's own.
+    pub fn step(&mut self, link_us: Option<u32>) {
+        let t_us = self.t_us();
+        let s = Sample {
+            t_us,
+            angle: self.sense(),
+            failed: false,
+            late: false,
+        };
+        if self.rig.sample(s) {
+            let mut hw = Hardware {
+                plant: &mut self.plant,
+                y: &self.y,
+                crank_sign: self.params.crank_sign,
+                current_offset: self.params.current_offset,
+            };
+            let tick = self
+                .rig
+                .control(link_us.unwrap_or(t_us), &mut hw, Some(self.estop));
+            if !tick.bridge {
+                self.plant.duty = 0.0;
+            }
+            if let Some(deg) = tick.servo_deg {
+                self.servo_target_deg = deg;
+            }
+            if tick.store.is_some() {
+                // The simulated flash always takes the write.
+                self.rig.config_saved(true);
+            }
+            self.last_tick = Some(tick);
+        }
+        let h = 1.0 / f64::from(self.rig.sample_hz());
+        self.slew_servo(h);
+        self.y = rk4_step(&self.plant, self.seconds(), &self.y, h, &mut self.stats);
+        if self.plant.jammed {
+            self.y[3] = 0.0;
+        }
+        self.k += 1;
+    }
+
+    /// Runs `secs` of rig time with the link's clock the rig's own.
+    pub fn run(&mut self, secs: f64) {
+        let n = libm::round(secs * f64::from(self.rig.sample_hz())) as u64;
+        for _ in 0..n {
+            self.step(None);
+        }
+    }
+
+    /// Bytes from the laptop (`link_us`: the link's clock; `None`: the rig's own).
+    pub fn receive(&mut self, bytes: &[u8], link_us: Option<u32>) {
+        let t = self.t_us();
+        self.rig.receive(bytes, link_us.unwrap_or(t));
+    }
+
+    /// Bytes for the laptop: as many queued frame bytes as fit in `out`.
+    pub fn transmit(&mut self, out: &mut [u8]) -> usize {
+        self.rig.transmit(out)
+    }
+
+    pub fn rig(&self) -> &RigLoop {
+        &self.rig
+    }
+
+    pub fn counters(&self) -> &Counters {
+        self.rig.counters()
+    }
+
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The last control tick's outputs.
+    pub fn last_tick(&self) -> Option<&Tick> {
+        self.last_tick.as_ref()
+    }
+
+    /// Jams the crank (a stalled motor) or frees it.
+    pub fn jam(&mut self, jammed: bool) {
+        self.plant.jammed = jammed;
+    }
+
+    /// Right-hand-side evaluations so far (the physics' cost).
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    pub fn truth(&self) -> Truth {
+        Truth {
+            t: self.seconds(),
+            theta: self.y[0],
+            theta_rate: self.y[1],
+            crank: self.y[2],
+            crank_speed: self.y[3],
+            theta_d_deg: math::to_deg(self.plant.theta_d),
+            duty: self.plant.duty,
+        }
+    }
+
+    /// What the pendulum sensor reports: its own zero and direction, noise, 14 bits, as the
+    /// firmware turns a sensor count into an angle (count · 2^18 of 2^32 per turn).
+    fn sense(&mut self) -> Angle {
+        let p = &self.params;
+        let seen =
+            p.sensor_sign * (self.y[0] - p.sensor_zero) + p.sensor_noise * self.noise.gaussian();
+        let counts = f64::from(1u32 << SENSOR_BITS);
+        let code = libm::round(seen / math::TAU * counts) as i64;
+        let code = code.rem_euclid(1 << SENSOR_BITS) as u32;
+        Angle::from_turns_u32(code << (32 - SENSOR_BITS))
+    }
+
+    /// The servo moves the mount toward its commanded position at its own rate.
+    fn slew_servo(&mut self, h: f64) {
+        let step = self.params.servo_rate_deg * h;
+        let d = self.servo_target_deg - self.servo_deg;
+        self.servo_deg += d.clamp(-step, step);
+        self.plant.theta_d = math::to_rad(self.servo_deg + self.params.servo_offset_deg);
+    }
+}
+
+/// The drive hardware as the rig loop sees it.
+struct Hardware<'a> {
+    plant: &'a mut Plant,
+    y: &'a [f64; 4],
+    crank_sign: f64,
+    current_offset: f64,
+}
+
+impl Motor for Hardware<'_> {
+    fn crank_angle(&mut self) -> Angle {
+        let counts = libm::floor(self.crank_sign * self.y[2] / math::TAU * f64::from(CRANK_COUNTS));
+        let count = (counts as i64).rem_euclid(i64::from(CRANK_COUNTS)) as u32;
+        Angle::from_turns_u32(count * (u32::MAX / CRANK_COUNTS + 1))
+    }
+    fn current(&mut self) -> Amps {
+        let i = self.plant.motor.current(self.plant.duty, self.y[3]) + self.current_offset;
+        Amps::saturating_from_num(i)
+    }
+    fn set_duty(&mut self, duty: Duty) {
+        self.plant.duty = duty.to_num();
+    }
+}

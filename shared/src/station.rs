@@ -1,0 +1,399 @@
+//! The rig loop: one rig and its end of the serial link, free of hardware. The firmware, the
+//! on-target tests and the simulated rig all run a rig through this one type, so every rig
+//! decision — when the control tick runs, when the H-bridge may be on, how a request reaches
+//! the rig and when it is answered, telemetry pacing, the counters — is made here, once.
+//!
+//! ```text
+//! caller (firmware, simulator)          RigLoop
+//! every pendulum sample  sample(s)   →  DDS tick, estimator; failed / late samples counted;
+//!                                       true when a control tick is due (every fs/fc samples)
+//! control tick  control(link_us, motor, e-stop)
+//!                                    →  safety, DDS, phase lock → duty; Tick: bridge on only
+//!                                       while running or stopping, θd for the servo when it
+//!                                       moved, a configuration to store; telemetry queued when due
+//! bytes from the laptop  receive(…)  →  frames checked and answered at once, in order;
+//!                                       the answers queued behind earlier frames
+//! the line can take bytes  transmit  →  queued frame bytes, oldest first
+//! flash written  config_saved(ok)
+//! ```
+//!
+//! **Requests are answered where they are decoded**, in the caller's control context, so there
+//! is no queue between the link and the rig and no timeout: a request is either carried out
+//! and answered `Ok`, or refused and changes nothing — it can never be reported as not taken
+//! and then carried out, and every answer carries its own request's sequence number. The
+//! caller calls `receive` from the same context as `control` (the firmware: at the control
+//! tick, with the bytes its UART task collected), which keeps the rig single-owner.
+//!
+//! **The output never blocks the loop.** Frames wait in a fixed outbox until the caller's line
+//! takes them. Telemetry is queued only while room for one answer is left behind it; a frame
+//! that does not fit is dropped and counted (`Counters::frames_dropped`).
+//!
+//! **An unknown e-stop line counts as pressed**: the rig cannot start blind.
+
+use crate::link::frame::{decode_request_as, encode, open, Header};
+use crate::link::message::Counters;
+use crate::link::serve::{Clock, Effect, RigServer};
+use crate::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
+use crate::persist::ConfigOrigin;
+use crate::rig::config::RigConfig;
+use crate::rig::controller::ControlReport;
+use crate::rig::estimator::Tuning;
+use crate::rig::fixed::{Amps, Angle};
+use crate::rig::phase_lock::Motor;
+use crate::rig::safety::Mode;
+
+/// The shortest telemetry period (ms): a telemetry frame is ≤ 100 bytes, 8.7 ms at 115200 baud.
+pub const MIN_TELEMETRY_MS: u16 = 20;
+
+/// Room for this many of the largest frames in the outbox.
+const OUTBOX_FRAMES: usize = 4;
+const OUTBOX: usize = OUTBOX_FRAMES * MAX_RESPONSE_FRAME;
+
+/// One pendulum-angle sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sample {
+    /// When it was read (µs on the rig's clock, wrapping).
+    pub t_us: u32,
+    /// The pendulum angle (the last good one if this read failed).
+    pub angle: Angle,
+    /// The read failed (bus error, parity, or the sensor's error flag).
+    pub failed: bool,
+    /// Taken more than half a sample period late.
+    pub late: bool,
+}
+
+/// What the caller must do after a control tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tick {
+    /// The H-bridge may be awake: only while the drive runs or ramps down.
+    pub bridge: bool,
+    /// θd moved: the servo's new position, degrees along the mount's travel.
+    pub servo_deg: Option<f64>,
+    /// A configuration was accepted: write it to flash, then call [`RigLoop::config_saved`].
+    /// Its sample rate is in use from the next sample on.
+    pub store: Option<RigConfig>,
+    /// What the control tick did.
+    pub report: ControlReport,
+}
+
+/// Frame bytes waiting for the line: a byte ring of fixed size.
+#[derive(Debug, Clone)]
+struct Outbox {
+    buf: [u8; OUTBOX],
+    head: usize,
+    len: usize,
+}
+
+impl Outbox {
+    const fn new() -> Self {
+        Self {
+            buf: [0; OUTBOX],
+            head: 0,
+            len: 0,
+        }
+    }
+
+    fn free(&self) -> usize {
+        OUTBOX - self.len
+    }
+
+    /// Queues a whole frame, or nothing if it does not fit.
+    fn push(&mut self, frame: &[u8]) -> bool {
+        if frame.len() > self.free() {
+            return false;
+        }
+        for &b in frame {
+            self.buf[(self.head + self.len) % OUTBOX] = b;
+            self.len += 1;
+        }
+        true
+    }
+
+    fn pop(&mut self, out: &mut [u8]) -> usize {
+        let n = out.len().min(self.len);
+        for o in &mut out[..n] {
+            *o = self.buf[self.head];
+            self.head = (self.head + 1) % OUTBOX;
+        }
+        self.len -= n;
+        n
+    }
+}
+
+/// One rig and its link: see the [module doc](self).
+#[derive(Debug, Clone)]
+pub struct RigLoop {
+    srv: RigServer,
+    reader: FrameReader<MAX_REQUEST_FRAME>,
+    out: Outbox,
+    samples_per_control: u32,
+    since_control: u32,
+    /// Telemetry every this many control ticks (0: off), and the ticks since the last one.
+    telemetry_every: u32,
+    since_telemetry: u32,
+    telemetry_seq: u8,
+    /// The e-stop line at the last control tick.
+    estop: bool,
+    servo: Option<Angle>,
+    store: Option<RigConfig>,
+    last: Sample,
+    uptime_us: u64,
+    current: Amps,
+}
+
+impl RigLoop {
+    /// A stopped rig on `cfg` (validated; [`crate::persist::load`] gives one), θd at
+    /// `theta_d0`, both clocks at `now_us`.
+    pub fn new(
+        cfg: RigConfig,
+        origin: ConfigOrigin,
+        theta_d0: Angle,
+        now_us: u32,
+        firmware: [u16; 3],
+    ) -> Self {
+        let srv = RigServer::new(
+            cfg,
+            origin,
+            Tuning::DEFAULT,
+            theta_d0,
+            Clock::single(now_us, 0),
+            firmware,
+        );
+        Self {
+            samples_per_control: per_control(&cfg),
+            srv,
+            reader: FrameReader::new(),
+            out: Outbox::new(),
+            since_control: 0,
+            telemetry_every: 0,
+            since_telemetry: 0,
+            telemetry_seq: 0,
+            estop: true,
+            servo: None,
+            store: None,
+            last: Sample {
+                t_us: now_us,
+                angle: Angle::ZERO,
+                failed: false,
+                late: false,
+            },
+            uptime_us: 0,
+            current: Amps::ZERO,
+        }
+    }
+
+    /// The same rig speaking protocol `version` on the link: for tests of what a host does
+    /// about version skew, never on a real rig.
+    pub fn speaking(mut self, version: u8) -> Self {
+        self.srv.protocol = version;
+        self
+    }
+
+    /// One pendulum sample. Returns `true` when a control tick is due now.
+    pub fn sample(&mut self, s: Sample) -> bool {
+        let c = &mut self.srv.counters;
+        if s.failed {
+            c.sensor_errors = c.sensor_errors.saturating_add(1);
+        }
+        if s.late {
+            c.overruns = c.overruns.saturating_add(1);
+        }
+        self.uptime_us += u64::from(s.t_us.wrapping_sub(self.last.t_us));
+        self.last = s;
+        self.srv.rig.sample(s.t_us, s.angle);
+        self.since_control += 1;
+        if self.since_control < self.samples_per_control {
+            return false;
+        }
+        self.since_control = 0;
+        true
+    }
+
+    /// The control tick, at the time of the last sample. `link_us` is the link's clock (the
+    /// rig's own on hardware); `estop` the e-stop line, `None` while it is unknown (pressed).
+    pub fn control<M: Motor>(&mut self, link_us: u32, motor: &mut M, estop: Option<bool>) -> Tick {
+        self.estop = estop.unwrap_or(true);
+        let t = self.last.t_us;
+        let mut m = Metered {
+            motor,
+            current: self.current,
+        };
+        let report = self.srv.rig.control_at(t, link_us, &mut m, self.estop);
+        self.current = m.current;
+        let servo_deg = (self.servo != Some(report.theta_d)).then(|| {
+            self.servo = Some(report.theta_d);
+            crate::link::convert::deg_along_travel(
+                report.theta_d,
+                self.srv.cfg.limits.drive_angle_min_deg,
+            )
+        });
+        if self.telemetry_every > 0 {
+            self.since_telemetry += 1;
+            if self.since_telemetry >= self.telemetry_every {
+                self.since_telemetry = 0;
+                let tm = self
+                    .srv
+                    .telemetry(t, &report, self.last.angle, self.current);
+                self.telemetry_seq = self.telemetry_seq.wrapping_add(1);
+                self.queue(self.telemetry_seq, &Response::Telemetry(tm), true);
+            }
+        }
+        Tick {
+            bridge: matches!(report.mode, Mode::Running | Mode::Stopping(_)),
+            servo_deg,
+            store: self.store.take(),
+            report,
+        }
+    }
+
+    /// Bytes from the laptop. Every frame they complete is checked and answered at once; a bad
+    /// frame is answered with its reason (seq 0 if its CRC failed). `link_us` on the link's
+    /// clock.
+    pub fn receive(&mut self, bytes: &[u8], link_us: u32) {
+        for &b in bytes {
+            let Some(got) = self.reader.push(b) else {
+                continue;
+            };
+            let (seq, req) = match got {
+                Ok(stuffed) => match open(stuffed) {
+                    Ok(f) => (f.header.seq, decode_request_as(&f, self.srv.protocol)),
+                    Err(r) => (0, Err(r)),
+                },
+                Err(r) => (0, Err(r)),
+            };
+            let c = &mut self.srv.counters;
+            let resp = match req {
+                Ok(req) => {
+                    c.frames_ok = c.frames_ok.saturating_add(1);
+                    self.answer(req, link_us)
+                }
+                Err(reason) => {
+                    c.frames_bad = c.frames_bad.saturating_add(1);
+                    Response::Refused(reason)
+                }
+            };
+            self.queue(seq, &resp, false);
+        }
+    }
+
+    /// A line error (overrun, framing, noise) on the laptop link: the partial frame is dropped
+    /// and counted as bad.
+    pub fn line_error(&mut self) {
+        self.reader.reset();
+        let c = &mut self.srv.counters;
+        c.frames_bad = c.frames_bad.saturating_add(1);
+    }
+
+    /// Moves queued frame bytes into `out` (as many as fit); returns how many.
+    pub fn transmit(&mut self, out: &mut [u8]) -> usize {
+        self.out.pop(out)
+    }
+
+    /// Bytes waiting for the line.
+    pub fn pending(&self) -> usize {
+        self.out.len
+    }
+
+    /// The store asked for by [`Tick::store`] finished (`ok`: it reached flash).
+    pub fn config_saved(&mut self, ok: bool) {
+        self.srv.config_saved(ok);
+    }
+
+    /// The rig and its configuration, counters and origin.
+    pub fn server(&self) -> &RigServer {
+        &self.srv
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &RigConfig {
+        &self.srv.cfg
+    }
+
+    pub fn counters(&self) -> &Counters {
+        &self.srv.counters
+    }
+
+    /// The sample rate the rig expects now (Hz).
+    pub fn sample_hz(&self) -> u32 {
+        self.srv.cfg.sample_hz
+    }
+
+    fn answer(&mut self, req: Request, link_us: u32) -> Response {
+        let at = Clock {
+            rig_us: self.last.t_us,
+            link_us,
+            uptime_ms: (self.uptime_us / 1000) as u32,
+        };
+        let (resp, effect) = self.srv.respond(req, at, self.estop);
+        match effect {
+            Effect::None => {}
+            Effect::StoreConfig(cfg) => {
+                self.samples_per_control = per_control(&cfg);
+                self.since_control = 0;
+                self.telemetry_every = telemetry_ticks(self.telemetry_ms(), &cfg);
+                self.store = Some(cfg);
+            }
+            Effect::Telemetry { period_ms } => {
+                self.telemetry_every = telemetry_ticks(period_ms, &self.srv.cfg);
+                self.since_telemetry = self.telemetry_every.saturating_sub(1);
+            }
+        }
+        resp
+    }
+
+    /// The telemetry period in use (ms; 0 when off).
+    fn telemetry_ms(&self) -> u16 {
+        let hz = self.srv.cfg.control_hz.max(1);
+        u16::try_from(u64::from(self.telemetry_every) * 1000 / u64::from(hz)).unwrap_or(u16::MAX)
+    }
+
+    /// Frames `resp` into the outbox. Telemetry leaves room for one answer behind it.
+    fn queue(&mut self, seq: u8, resp: &Response, telemetry: bool) {
+        let mut frame = [0u8; MAX_RESPONSE_FRAME];
+        let header = Header {
+            version: self.srv.protocol,
+            seq,
+        };
+        let Ok(n) = encode(header, resp, &mut frame) else {
+            return;
+        };
+        let reserve = if telemetry { MAX_RESPONSE_FRAME } else { 0 };
+        if n + reserve > self.out.free() || !self.out.push(&frame[..n]) {
+            let c = &mut self.srv.counters;
+            c.frames_dropped = c.frames_dropped.saturating_add(1);
+        }
+    }
+}
+
+/// The motor, with the current it reports kept for the telemetry.
+struct Metered<'a, M> {
+    motor: &'a mut M,
+    current: Amps,
+}
+
+impl<M: Motor> Motor for Metered<'_, M> {
+    fn crank_angle(&mut self) -> Angle {
+        self.motor.crank_angle()
+    }
+    fn current(&mut self) -> Amps {
+        self.current = self.motor.current();
+        self.current
+    }
+    fn set_duty(&mut self, duty: crate::rig::fixed::Duty) {
+        self.motor.set_duty(duty)
+    }
+}
+
+fn per_control(cfg: &RigConfig) -> u32 {
+    cfg.derived().samples_per_control.max(1)
+}
+
+/// `period_ms` (raised to [`MIN_TELEMETRY_MS`]) in control ticks; 0 stays off.
+fn telemetry_ticks(period_ms: u16, cfg: &RigConfig) -> u32 {
+    if period_ms == 0 {
+        return 0;
+    }
+    let ms = u64::from(period_ms.max(MIN_TELEMETRY_MS));
+    let ticks = (ms * u64::from(cfg.control_hz)).div_ceil(1000);
+    u32::try_from(ticks).unwrap_or(u32::MAX).max(1)
+}
