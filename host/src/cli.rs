@@ -22,6 +22,14 @@ pub enum Command {
     Boundary(cmd::boundary::Args),
     Simulate(cmd::simulate::Args),
     Bench(cmd::bench::Args),
+    Ports(cmd::ports::Args),
+    Status(cmd::status::Args),
+    Set(cmd::set::Args),
+    Stop(cmd::stop::StopArgs),
+    Clear(cmd::stop::ClearArgs),
+    Config(cmd::config::Args),
+    /// A simulated rig for serial clients.
+    Rig(cmd::rig_serve::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -35,7 +43,8 @@ pub enum Error {
 
 impl Error {
     /// Prints the error (to stderr) and returns the exit status: 2 for usage errors as clap does,
-    /// 1 for anything else, 0 for `--help`.
+    /// 0 for `--help`, a rig command's own status ([`crate::rig::Exit`]: 3 no rig, 4 `--wait`
+    /// timed out), 1 for anything else.
     pub fn report(&self) -> ExitCode {
         match self {
             Self::Usage(e) => {
@@ -44,7 +53,10 @@ impl Error {
             }
             Self::Run(e) => {
                 eprintln!("error: {e:#}");
-                ExitCode::from(1)
+                let code = e
+                    .downcast_ref::<crate::rig::Failure>()
+                    .map_or(1, |f| f.exit as u8);
+                ExitCode::from(code)
             }
         }
     }
@@ -78,6 +90,13 @@ where
         Command::Boundary(a) => cmd::boundary::run(&a, out)?,
         Command::Simulate(a) => cmd::simulate::run(&a, out)?,
         Command::Bench(a) => cmd::bench::run(&a, out)?,
+        Command::Ports(a) => cmd::ports::run(&a, out)?,
+        Command::Status(a) => cmd::status::run(&a, out)?,
+        Command::Set(a) => cmd::set::run(&a, out)?,
+        Command::Stop(a) => cmd::stop::stop(&a, out)?,
+        Command::Clear(a) => cmd::stop::clear(&a, out)?,
+        Command::Config(a) => cmd::config::run(&a, out)?,
+        Command::Rig(a) => cmd::rig_serve::run(&a, out)?,
     }
     Ok(())
 }

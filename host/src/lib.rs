@@ -11,6 +11,7 @@
 //! | [`scene_file`] | scene files (TOML) and `--set` → the core's `Scene`, run options, `[expect]` |
 //! | [`outcome`] | the simulator's verdict in user terms, and `[expect]` judged against it |
 //! | [`record`] | what a run keeps for the output files, and its progress bar |
+//! | [`rig`] | the rig from the laptop: ports, the simulated rig, checked connections, the port's owner |
 //! | [`csv_out`] | the samples as CSV |
 //! | [`plot`] | PNG plots with a bundled font |
 //! | [`timing`] | measured cost of a function |
@@ -24,6 +25,7 @@ pub mod link;
 pub mod outcome;
 pub mod plot;
 pub mod record;
+pub mod rig;
 pub mod scene_file;
 pub mod timing;
 

@@ -163,7 +163,7 @@ struct RawScene {
 
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(rename_all = "lowercase")]
-enum GeometryName {
+pub(crate) enum GeometryName {
     Rod,
     Point,
     General,
@@ -171,7 +171,7 @@ enum GeometryName {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a table: [pendulum]")]
-struct RawPendulum {
+pub(crate) struct RawPendulum {
     geometry: GeometryName,
     length: Option<f64>,
     inertia: Option<f64>,
@@ -190,9 +190,9 @@ struct RawDrive {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a table: [environment]")]
-struct RawEnvironment {
+pub(crate) struct RawEnvironment {
     #[serde(default = "standard_gravity")]
-    gravity: f64,
+    pub(crate) gravity: f64,
 }
 
 fn standard_gravity() -> f64 {
@@ -344,7 +344,11 @@ struct RawExpect {
 // Conversion and checks.
 
 /// `key = value` is out of range.
-fn out_of_range(key: &str, value: impl std::fmt::Display, allowed: &str) -> anyhow::Error {
+pub(crate) fn out_of_range(
+    key: &str,
+    value: impl std::fmt::Display,
+    allowed: &str,
+) -> anyhow::Error {
     anyhow!("{key} = {value} is out of range: allowed {allowed}")
 }
 
@@ -439,7 +443,7 @@ fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     })
 }
 
-fn pendulum(p: &RawPendulum) -> Result<Geometry> {
+pub(crate) fn pendulum(p: &RawPendulum) -> Result<Geometry> {
     let name = match p.geometry {
         GeometryName::Rod => "rod",
         GeometryName::Point => "point",

@@ -2,5 +2,12 @@
 
 pub mod bench;
 pub mod boundary;
+pub mod config;
+pub mod ports;
 pub mod predict;
+pub mod rig_args;
+pub mod rig_serve;
+pub mod set;
 pub mod simulate;
+pub mod status;
+pub mod stop;

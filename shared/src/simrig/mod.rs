@@ -68,14 +68,15 @@ pub struct Params {
 }
 
 impl Params {
-    /// The demo rod of SPEC §4 (L = 0.25 m, A = 12.7 mm), lightly damped (Q ≈ 25), on the
+    /// The demo rod of SPEC §4 (L = 0.25 m, A = 12.7 mm), damped to Q = 10 (c = ω0/Q with
+    /// ω0 = √(3g/2L) = 7.672 rad/s), on the
     /// default motor, a quiet sensor (0.02°) and a fast servo, hanging at rest.
     pub const DEMO: Self = Self {
         geometry: Geometry::Rod { length: 0.25 },
         gravity: 9.81,
         amplitude: 0.0127,
         connecting_rod: None,
-        damping: 0.3,
+        damping: 0.7672,
         coulomb: 0.0,
         motor: MotorModel::DEFAULT,
         sensor_noise: 3.5e-4,

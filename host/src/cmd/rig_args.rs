@@ -1,0 +1,45 @@
+//! The arguments every rig command shares: which rig, and the simulated one's physics.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use crate::rig::file::{self, RigFile};
+use crate::rig::port::{self, Target};
+use crate::rig::session::{self, Session};
+use crate::rig::simhost::SimOptions;
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct RigArgs {
+    /// The rig's serial port: a device path (a board's virtual COM port, or the pty that
+    /// `kapitza rig serve` prints), `auto` (the one ST-LINK virtual COM port attached), or `sim`
+    /// (a simulated rig in this process). Default: $KAPITZA_PORT, else `auto`.
+    #[arg(long, value_name = "PORT")]
+    pub port: Option<String>,
+    /// With `--port sim`: the simulated rig's file (default: the demo rod, rigs/demo.toml).
+    #[arg(long, value_name = "FILE")]
+    pub sim: Option<PathBuf>,
+    /// With `--port sim`: rig seconds per wall second.
+    #[arg(long, default_value_t = 1.0, value_name = "X")]
+    pub speed: f64,
+}
+
+impl RigArgs {
+    pub fn target(&self) -> Result<Target> {
+        port::resolve(self.port.as_deref())
+    }
+
+    pub fn sim_options(&self) -> Result<SimOptions> {
+        let rig = match &self.sim {
+            Some(p) => file::load(p)?,
+            None => RigFile::demo(),
+        };
+        let speed = crate::input::positive("--speed", self.speed)?;
+        Ok(SimOptions::new(rig, speed))
+    }
+
+    /// A checked connection to the rig.
+    pub fn connect(&self) -> Result<Session> {
+        session::connect(&self.target()?, &self.sim_options()?)
+    }
+}

@@ -1,0 +1,159 @@
+//! `kapitza rig serve`: a simulated rig on a pseudo-terminal, for any serial client.
+//!
+//! The rig loop is the firmware's (`kapitza_core::station`), the physics `kapitza_core::simrig`
+//! from a rig file. The first line on stdout, flushed at once, is the device path; `--link`
+//! also publishes it as a stable symlink, so a restarted rig is found at the same name. The pty's
+//! other end stays open here, so a client may come and go.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::os::fd::AsRawFd;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use serialport::{SerialPort, TTYPort};
+
+use super::rig_args::RigArgs;
+use crate::rig::simhost::{self, Line};
+use crate::rig::{self as rigmod};
+
+#[derive(Debug, clap::Subcommand)]
+pub enum Action {
+    /// Serve a simulated rig on a pseudo-terminal (Unix): prints the device path, then runs
+    /// until Ctrl-C or --duration.
+    Serve(ServeArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub action: Action,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct ServeArgs {
+    /// The simulated rig's file (default: the demo rod, rigs/demo.toml).
+    #[arg(long, value_name = "FILE")]
+    pub sim: Option<PathBuf>,
+    /// Rig seconds per wall second (the link-silence timeout stays on wall time).
+    #[arg(long, default_value_t = 1.0, value_name = "X")]
+    pub speed: f64,
+    /// Also publish the device as this symlink (an existing symlink there is replaced).
+    #[arg(long, value_name = "PATH")]
+    pub link: Option<PathBuf>,
+    /// Write every setting the rig applied to this file, one JSON line each.
+    #[arg(long, value_name = "FILE")]
+    pub truth: Option<PathBuf>,
+    /// Stop after this many wall seconds (default: run until Ctrl-C).
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Speak this link protocol version instead of this tool's (for tests of version skew).
+    #[arg(long, hide = true)]
+    pub protocol: Option<u8>,
+}
+
+/// The pty's master end, never blocking.
+struct Pty(TTYPort);
+
+fn nonblocking(e: io::Error) -> io::Result<usize> {
+    match e.kind() {
+        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut | io::ErrorKind::Interrupted => Ok(0),
+        _ => Err(e),
+    }
+}
+
+impl Line for Pty {
+    fn take(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        io::Read::read(&mut self.0, buf).or_else(nonblocking)
+    }
+    fn give(&mut self, buf: &[u8]) -> io::Result<usize> {
+        io::Write::write(&mut self.0, buf).or_else(nonblocking)
+    }
+}
+
+fn set_nonblocking(port: &TTYPort) -> Result<()> {
+    let fd = port.as_raw_fd();
+    // SAFETY: fcntl on a descriptor this process owns, with flags it just read.
+    let ok = unsafe {
+        let flags = libc::fcntl(fd, libc::F_GETFL);
+        flags >= 0 && libc::fcntl(fd, libc::F_SETFL, flags | libc::O_NONBLOCK) == 0
+    };
+    if !ok {
+        bail!(
+            "cannot make the pseudo-terminal non-blocking: {}",
+            io::Error::last_os_error()
+        );
+    }
+    Ok(())
+}
+
+/// Points `link` at `target`, replacing a symlink (never a regular file) that is there.
+fn publish(link: &std::path::Path, target: &str) -> Result<()> {
+    if let Ok(meta) = std::fs::symlink_metadata(link) {
+        if !meta.file_type().is_symlink() {
+            bail!(
+                "--link {}: exists and is not a symlink; not replaced",
+                link.display()
+            );
+        }
+        std::fs::remove_file(link).with_context(|| format!("--link {}", link.display()))?;
+    }
+    std::os::unix::fs::symlink(target, link).with_context(|| format!("--link {}", link.display()))
+}
+
+pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    let Action::Serve(a) = &args.action;
+    let rig = RigArgs {
+        port: None,
+        sim: a.sim.clone(),
+        speed: a.speed,
+    };
+    let mut opts = rig.sim_options()?;
+    opts.protocol = a.protocol;
+    let duration = a
+        .duration
+        .map(|d| crate::input::positive("--duration", d))
+        .transpose()?;
+    let mut truth = match &a.truth {
+        Some(p) => Some(BufWriter::new(
+            File::create(p).with_context(|| format!("--truth {}", p.display()))?,
+        )),
+        None => None,
+    };
+    let (mut master, slave) = TTYPort::pair().context("cannot open a pseudo-terminal")?;
+    set_nonblocking(&master)?;
+    master.set_timeout(std::time::Duration::ZERO)?;
+    let path = slave.name().context("the pseudo-terminal has no name")?;
+    if let Some(link) = &a.link {
+        publish(link, &path)?;
+    }
+    writeln!(out, "{path}")?;
+    out.flush()?;
+    rigmod::catch_interrupt();
+    let start = Instant::now();
+    let stop =
+        || rigmod::interrupted() || duration.is_some_and(|d| start.elapsed().as_secs_f64() >= d);
+    let cpu0 = crate::bench::clock::thread_cpu();
+    let summary = simhost::run(
+        opts.build(),
+        opts.speed,
+        &mut Pty(master),
+        &stop,
+        truth.as_mut().map(|w| w as &mut dyn Write),
+    );
+    drop(slave);
+    if let Some(link) = &a.link {
+        let _ = std::fs::remove_file(link);
+    }
+    let s = summary?;
+    let cpu = crate::bench::clock::thread_cpu() - cpu0;
+    eprintln!(
+        "rig serve: {:.1} rig seconds in {:.1} s ({:.1}× real time), {:.1} % of one core",
+        s.rig_seconds,
+        s.wall_seconds,
+        s.rig_seconds / s.wall_seconds.max(1e-9),
+        100.0 * cpu / s.wall_seconds.max(1e-9)
+    );
+    Ok(())
+}

@@ -1,0 +1,185 @@
+//! `kapitza set`: drive strength R and drive angle θd.
+//!
+//! Through a running owner of the port (`kapitza attach`, `kapitza monitor`) it returns once
+//! the rig has taken the command, or with `--wait` once the pendulum has settled. On its own it
+//! owns the port and stays attached, printing the status as it changes, until the pendulum has
+//! settled (`--wait`; then the drive follows the rig's link-loss policy: a soft stop a second
+//! later) or until Ctrl-C, which stops the drive.
+
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Result};
+use kapitza_core::link::message::Mode;
+use kapitza_core::link::Telemetry;
+
+use super::rig_args::RigArgs;
+use crate::link::{Error, LineError};
+use crate::rig::session::{line_failure, Session, StatusView};
+use crate::rig::{self, Exit, Failure};
+
+/// Set the drive strength R and the drive angle θd: starts the drive from idle, or changes it
+/// (ramped and slewed at the rig's rate limits). R = 0 stops.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub rig: RigArgs,
+    /// Drive strength R = A²ω²/(2gℓ), ≥ 0; the rig computes ω from its configured pendulum and
+    /// stroke.
+    #[arg(long, allow_hyphen_values = true)]
+    pub r: f64,
+    /// Drive angle θd in degrees: 0 shakes vertically, 90 horizontally, 180 vertically with
+    /// the rod above the pivot.
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub angle: f64,
+    /// Return once the pendulum has settled (exit 4 if it has not within --timeout).
+    #[arg(long)]
+    pub wait: bool,
+    /// With --wait: seconds (wall time) to wait for it.
+    #[arg(long, default_value_t = 120.0, value_name = "S", requires = "wait")]
+    pub timeout: f64,
+    /// One JSON object at the end (the keys of `kapitza status --json`); progress goes to stderr.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// How often the link is kept alive while waiting.
+const KEEP_ALIVE: Duration = Duration::from_millis(250);
+/// A progress line at least this often, and whenever the stage changes.
+const PROGRESS_EVERY: Duration = Duration::from_secs(1);
+
+pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    if !(args.r.is_finite() && args.r >= 0.0) {
+        bail!(
+            "--r {} is out of range: expected a finite number >= 0",
+            args.r
+        );
+    }
+    if !args.angle.is_finite() {
+        bail!(
+            "--angle {} is out of range: expected a finite number of degrees",
+            args.angle
+        );
+    }
+    let timeout = crate::input::positive("--timeout", args.timeout)?;
+    rig::catch_interrupt();
+    let mut s = args.rig.connect()?;
+    s.call(|c| c.set_drive(args.r, args.angle))?;
+    let after = s.call(|c| c.status())?.counters.commands;
+    let mut progress: Box<dyn Write> = if args.json {
+        Box::new(std::io::stderr())
+    } else {
+        Box::new(&mut *out)
+    };
+    writeln!(
+        progress,
+        "{}: R = {} at θd = {}° taken",
+        s.name, args.r, args.angle
+    )?;
+    let done = if (s.via_owner && !args.wait) || args.r == 0.0 {
+        true
+    } else {
+        let deadline = args
+            .wait
+            .then(|| Instant::now() + Duration::from_secs_f64(timeout));
+        follow(&mut s, after, deadline, &mut progress)?
+    };
+    drop(progress);
+    if !done {
+        return Ok(());
+    }
+    let view = s.snapshot()?;
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&view)?)?;
+    } else {
+        writeln!(out, "{}", view.text())?;
+    }
+    Ok(())
+}
+
+/// Follows the rig until the pendulum has settled after command number `after` (returns true),
+/// Ctrl-C (the drive is stopped; returns false) or the deadline (exit 4). Without a deadline
+/// only Ctrl-C ends it.
+fn follow(
+    s: &mut Session,
+    after: u32,
+    deadline: Option<Instant>,
+    progress: &mut dyn Write,
+) -> Result<bool> {
+    s.call(|c| c.stream_telemetry(50))?;
+    let mut next_alive = Instant::now();
+    let mut last_stage = "";
+    let mut next_line = Instant::now();
+    loop {
+        if rig::interrupted() {
+            s.call(|c| c.stop())?;
+            writeln!(progress, "interrupted: the drive is stopping")?;
+            return Ok(false);
+        }
+        if deadline.is_some_and(|d| Instant::now() >= d) {
+            return Err(Failure::new(
+                Exit::WaitTimeout,
+                format!("{}: the pendulum has not settled within --timeout", s.name),
+            )
+            .into());
+        }
+        if Instant::now() >= next_alive {
+            next_alive = Instant::now() + KEEP_ALIVE;
+            let st = s.call(|c| c.status())?;
+            if let Mode::Faulted(_) | Mode::Idle = st.mode {
+                let v = StatusView::new(&st, None, &s.config);
+                let why = v.fault.or(v.last_stop).unwrap_or("stopped");
+                return Err(Failure::new(
+                    Exit::Refused,
+                    format!("{}: the drive stopped ({}): {why}", s.name, v.mode),
+                )
+                .into());
+            }
+        }
+        let t: Telemetry = match s.client.telemetry() {
+            Ok(t) => t,
+            Err(Error::Line(LineError::Timeout)) => continue,
+            Err(e) => return Err(line_failure(&s.name, e)),
+        };
+        if t.commands < after {
+            continue;
+        }
+        let stage = stage(&t);
+        if stage != last_stage || Instant::now() >= next_line {
+            writeln!(progress, "{}", progress_line(&t))?;
+            last_stage = stage;
+            next_line = Instant::now() + PROGRESS_EVERY;
+        }
+        if t.settled && deadline.is_some() {
+            return Ok(true);
+        }
+    }
+}
+
+/// What the drive and the estimator are doing.
+fn stage(t: &Telemetry) -> &'static str {
+    if t.settled {
+        "settled"
+    } else if t.steady {
+        "measuring"
+    } else {
+        "ramping"
+    }
+}
+
+/// One line of what the rig does.
+fn progress_line(t: &Telemetry) -> String {
+    use crate::rig::session::turns_deg;
+    use kapitza_core::link::convert::from_q16;
+    let phi = match (t.settled, t.equilibrium) {
+        (true, Some(e)) => turns_deg(e),
+        _ => turns_deg(t.phi),
+    };
+    format!(
+        "  ω = {:.0} rad/s, θd = {:.0}°, φ = {:.1}°, {}",
+        from_q16(t.omega),
+        from_q16(t.theta_d_deg),
+        phi,
+        stage(t)
+    )
+}

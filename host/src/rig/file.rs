@@ -1,0 +1,352 @@
+//! Rig files (TOML): the true physics of a simulated rig and, apart from it, what the rig is
+//! configured with — the way a real bench differs from what was typed in.
+//!
+//! The pendulum, gravity and stroke are written as in a scene (`[pendulum]`, `[environment]`,
+//! `[drive] amplitude`, `[effects]` with `viscous`, `coulomb`, `slider_crank`); the rest is the
+//! rig's own hardware. Every key is optional but `[pendulum]` and `[drive]`; docs/rig-file.md
+//! lists them. `[configured]` gives the configuration's pendulum and stroke where they differ
+//! (a mis-typed rig); by default the rig is configured with the file's true ones.
+
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context, Result};
+use kapitza_core::math;
+use kapitza_core::rig::config::RigConfig;
+use kapitza_core::simrig::plant::MotorModel;
+use kapitza_core::simrig::Params;
+use serde::Deserialize;
+
+use crate::scene_file::{out_of_range, pendulum, RawEnvironment, RawPendulum};
+
+/// A simulated rig: its truth and its configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigFile {
+    pub title: String,
+    pub params: Params,
+    pub config: RigConfig,
+}
+
+impl RigFile {
+    /// The demo rod (SPEC §4) configured as it is.
+    pub fn demo() -> Self {
+        Self {
+            title: "the demo rod (L = 0.25 m, A = 12.7 mm)".into(),
+            params: Params::DEMO,
+            config: Params::DEMO.configured(),
+        }
+    }
+}
+
+/// Reads and checks a rig file.
+pub fn load(path: &Path) -> Result<RigFile> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read the rig file {}", path.display()))?;
+    parse(&text).with_context(|| format!("rig file {}", path.display()))
+}
+
+/// Parses and checks the text of a rig file.
+pub fn parse(text: &str) -> Result<RigFile> {
+    let de = toml::Deserializer::parse(text).map_err(|e| anyhow!("{e}"))?;
+    let raw: RawRig = serde_path_to_error::deserialize(de).map_err(|e| anyhow!("{e}"))?;
+    convert(raw)
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a rig table")]
+struct RawRig {
+    title: Option<String>,
+    pendulum: RawPendulum,
+    #[serde(default)]
+    environment: RawEnvironment,
+    drive: RawStroke,
+    #[serde(default)]
+    effects: RawLosses,
+    #[serde(default)]
+    sensor: RawSensor,
+    #[serde(default)]
+    motor: RawMotor,
+    #[serde(default)]
+    crank: RawCrank,
+    #[serde(default)]
+    servo: RawServo,
+    #[serde(default)]
+    current: RawCurrent,
+    #[serde(default)]
+    initial: RawInitial,
+    seed: Option<u64>,
+    configured: Option<RawConfigured>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [drive] amplitude = … (m)")]
+struct RawStroke {
+    amplitude: f64,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table of effects: viscous, coulomb, slider_crank"
+)]
+struct RawLosses {
+    viscous: Option<RawViscous>,
+    coulomb: Option<RawCoulomb>,
+    slider_crank: Option<RawSliderCrank>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: viscous = { q = … }")]
+struct RawViscous {
+    q: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: coulomb = { torque = … }")]
+struct RawCoulomb {
+    torque: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table: slider_crank = { rod_length = … }"
+)]
+struct RawSliderCrank {
+    rod_length: f64,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [sensor]")]
+struct RawSensor {
+    noise_deg: Option<f64>,
+    zero_deg: Option<f64>,
+    #[serde(default)]
+    reversed: bool,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [motor]")]
+struct RawMotor {
+    omega_per_duty: Option<f64>,
+    lag_s: Option<f64>,
+    volts: Option<f64>,
+    ke: Option<f64>,
+    ohms: Option<f64>,
+    #[serde(default)]
+    reversed: bool,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [crank]")]
+struct RawCrank {
+    #[serde(default)]
+    reversed: bool,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [servo]")]
+struct RawServo {
+    rate_deg_s: Option<f64>,
+    offset_deg: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [current]")]
+struct RawCurrent {
+    offset: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [initial]")]
+struct RawInitial {
+    angle_deg: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [configured]")]
+struct RawConfigured {
+    pendulum: Option<RawPendulum>,
+    amplitude: Option<f64>,
+    gravity: Option<f64>,
+}
+
+fn in_range(key: &str, v: f64, lo: f64, hi: f64, allowed: &str) -> Result<f64> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(out_of_range(key, v, allowed))
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(out_of_range(key, v, "a finite number > 0"))
+    }
+}
+
+fn sign(reversed: bool) -> f64 {
+    if reversed {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+fn convert(raw: RawRig) -> Result<RigFile> {
+    let geometry = pendulum(&raw.pendulum)?;
+    let gravity = positive("environment.gravity", raw.environment.gravity)?;
+    let ell = geometry.equivalent_length();
+    let amplitude = in_range(
+        "drive.amplitude",
+        raw.drive.amplitude,
+        f64::MIN_POSITIVE,
+        0.1 * ell,
+        "in (0, 0.1 ℓ] m: a stroke small beside the pendulum",
+    )?;
+    let omega0 = math::sqrt(gravity / ell);
+    let damping = match &raw.effects.viscous {
+        Some(v) => omega0 / positive("effects.viscous.q", v.q)?,
+        None => 0.0,
+    };
+    let coulomb = match &raw.effects.coulomb {
+        Some(c) => in_range(
+            "effects.coulomb.torque",
+            c.torque,
+            0.0,
+            omega0 * omega0,
+            "in [0, ω0²] rad/s² (beyond it the pendulum could not hang)",
+        )?,
+        None => 0.0,
+    };
+    let connecting_rod = match &raw.effects.slider_crank {
+        Some(s) if s.rod_length.is_finite() && s.rod_length > 2.0 * amplitude => Some(s.rod_length),
+        Some(s) => {
+            return Err(out_of_range(
+                "effects.slider_crank.rod_length",
+                s.rod_length,
+                "a length > 2 × drive.amplitude (m)",
+            ))
+        }
+        None => None,
+    };
+    let d = MotorModel::DEFAULT;
+    let m = &raw.motor;
+    let motor = MotorModel {
+        omega_per_duty: positive(
+            "motor.omega_per_duty",
+            m.omega_per_duty.unwrap_or(d.omega_per_duty),
+        )?,
+        tau: positive("motor.lag_s", m.lag_s.unwrap_or(d.tau))?,
+        volts: positive("motor.volts", m.volts.unwrap_or(d.volts))?,
+        ke: positive("motor.ke", m.ke.unwrap_or(d.ke))?,
+        ohms: positive("motor.ohms", m.ohms.unwrap_or(d.ohms))?,
+        direction: sign(m.reversed),
+    };
+    let p = Params::DEMO;
+    let params = Params {
+        geometry,
+        gravity,
+        amplitude,
+        connecting_rod,
+        damping,
+        coulomb,
+        motor,
+        sensor_noise: math::to_rad(in_range(
+            "sensor.noise_deg",
+            raw.sensor.noise_deg.unwrap_or(math::to_deg(p.sensor_noise)),
+            0.0,
+            10.0,
+            "in [0, 10] degrees",
+        )?),
+        sensor_zero: math::to_rad(in_range(
+            "sensor.zero_deg",
+            raw.sensor.zero_deg.unwrap_or(0.0),
+            -180.0,
+            180.0,
+            "in [-180, 180] degrees",
+        )?),
+        sensor_sign: sign(raw.sensor.reversed),
+        crank_sign: sign(raw.crank.reversed),
+        servo_rate_deg: positive(
+            "servo.rate_deg_s",
+            raw.servo.rate_deg_s.unwrap_or(p.servo_rate_deg),
+        )?,
+        servo_offset_deg: in_range(
+            "servo.offset_deg",
+            raw.servo.offset_deg.unwrap_or(0.0),
+            -30.0,
+            30.0,
+            "in [-30, 30] degrees",
+        )?,
+        current_offset: in_range(
+            "current.offset",
+            raw.current.offset.unwrap_or(0.0),
+            -5.0,
+            5.0,
+            "in [-5, 5] A",
+        )?,
+        theta0: math::to_rad(in_range(
+            "initial.angle_deg",
+            raw.initial.angle_deg.unwrap_or(0.0),
+            -180.0,
+            180.0,
+            "in [-180, 180] degrees",
+        )?),
+        seed: raw.seed.unwrap_or(1),
+    };
+    let mut config = params.configured();
+    if let Some(c) = &raw.configured {
+        if let Some(pd) = &c.pendulum {
+            config.geometry = pendulum(pd).context("configured")?;
+        }
+        if let Some(a) = c.amplitude {
+            config.amplitude = positive("configured.amplitude", a)?;
+        }
+        if let Some(g) = c.gravity {
+            config.gravity = positive("configured.gravity", g)?;
+        }
+    }
+    let config = config.validate().map_err(|e| anyhow!("configured: {e}"))?;
+    if amplitude > 0.1 * ell {
+        bail!("drive.amplitude = {amplitude} is too large for the pendulum");
+    }
+    Ok(RigFile {
+        title: raw.title.unwrap_or_else(|| "simulated rig".into()),
+        params,
+        config,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_demo_file_is_the_demo_rig() {
+        let f = parse(include_str!("../../../rigs/demo.toml")).unwrap();
+        assert_eq!(f.params.geometry, Params::DEMO.geometry);
+        assert_eq!(f.params.amplitude, Params::DEMO.amplitude);
+        // Q = 10 in the file; Params::DEMO writes c = ω0/10 to 4 digits.
+        assert!((f.params.damping / Params::DEMO.damping - 1.0).abs() < 1e-4);
+        assert_eq!(f.config, Params::DEMO.configured());
+    }
+
+    #[test]
+    fn a_mistyped_rig_keeps_its_truth_apart() {
+        let f = parse(include_str!("../../../rigs/mistyped.toml")).unwrap();
+        assert_ne!(f.config.geometry, f.params.geometry);
+        assert_eq!(f.params.sensor_zero, math::to_rad(1.5));
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        let e = parse("[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n[servo]\noffset_deg = 90\n")
+            .unwrap_err();
+        assert!(format!("{e:#}").contains("servo.offset_deg = 90"), "{e:#}");
+        let e = parse("[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\nspeed = 3\n")
+            .unwrap_err();
+        assert!(format!("{e:#}").contains("speed"), "{e:#}");
+    }
+}
