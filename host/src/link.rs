@@ -181,6 +181,20 @@ impl<P: Read + Write> Client<P> {
         }
     }
 
+    /// Telemetry that has arrived by now, without waiting for more than one read.
+    pub fn telemetry_now(&mut self) -> Result<Option<Telemetry>, Error> {
+        if self.telemetry.is_empty() {
+            let _ = self.poll(0)?;
+        }
+        Ok(self.telemetry.pop_front())
+    }
+
+    /// Any request, answered (a refusal is [`Error::Refused`]); for a process that relays
+    /// requests for others.
+    pub fn request(&mut self, req: Request) -> Result<Response, Error> {
+        self.call(req)
+    }
+
     fn ok(&mut self, req: Request) -> Result<(), Error> {
         match self.call(req)? {
             Response::Ok => Ok(()),

@@ -1,5 +1,6 @@
 //! One module per subcommand: its arguments (doc comments are the help text) and `run()`.
 
+pub mod attach;
 pub mod bench;
 pub mod boundary;
 pub mod config;

@@ -47,6 +47,11 @@ pub fn connect(target: &Target, sim: &SimOptions) -> Result<Session> {
             );
         }
     }
+    open(target, sim)
+}
+
+/// Opens `target` itself, never through an owner (the owner's own way in).
+pub fn open(target: &Target, sim: &SimOptions) -> Result<Session> {
     let (port, name): (Box<dyn ReadWrite>, String) = match target {
         Target::Serial { path } => (Box::new(port::open_serial(path)?), path.clone()),
         Target::Sim => (Box::new(SimPort::start(sim)), target.describe()),
