@@ -1,4 +1,5 @@
-//! On-target test harness: runs every scenario of `kapitza_core::rig::selftest` on the emulated
+//! On-target test harness: runs every scenario of `kapitza_core::rig::selftest` and
+//! `kapitza_core::station::selftest` (the firmware's rig loop, bytes in and out) on the emulated
 //! Cortex-M4F and compares its digest with the expected one — the same digests the host tests
 //! check, so a pass here means host and target compute the same bits. Prints one line per
 //! scenario and `N passed, N failed`, and exits with a failure status if any failed.
@@ -9,12 +10,13 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use kapitza_core::rig::selftest::CASES;
+use kapitza_core::station::selftest::CASES as LOOP_CASES;
 
 #[entry]
 fn main() -> ! {
     let mut passed = 0u32;
     let mut failed = 0u32;
-    for c in CASES {
+    for c in CASES.iter().chain(LOOP_CASES) {
         let got = (c.run)();
         if got == c.expected {
             passed += 1;

@@ -1,13 +1,14 @@
-//! The on-target scenarios (`rig::selftest`) on the host: each must produce its expected digest,
+//! The on-target scenarios (`rig::selftest`, `station::selftest`) on the host: each must produce its expected digest,
 //! the same one the emulated Cortex-M4F must produce (`qemu/`), so host and target agree bit
 //! for bit. Prints every digest (`-- --nocapture`) for regeneration after a deliberate change.
 
 use kapitza_core::rig::selftest::CASES;
+use kapitza_core::station::selftest::CASES as LOOP_CASES;
 
 #[test]
 fn digests_match() {
     let mut bad = Vec::new();
-    for c in CASES {
+    for c in CASES.iter().chain(LOOP_CASES) {
         let got = (c.run)();
         println!("{:<22} 0x{got:016x}", c.name);
         if got != c.expected {

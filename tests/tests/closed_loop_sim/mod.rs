@@ -1,114 +1,21 @@
-//! The simulated rig for the closed-loop tests: pendulum, crank motor and sensors, stepped in
-//! virtual time against the real rig logic (`kapitza_core::rig::controller::Rig`).
-//!
-//! ```text
-//! pendulum (pivot frame, SPEC §3 with a general pivot motion s(t) along the drive line):
-//!   θ'' = −ω0² sin θ + (s''/ℓ) sin(θ − θd) − c θ'
-//!   s = A cos ψ,  s'' = −A (ψ'² cos ψ + ψ'' sin ψ)          ψ: the crank's *actual* angle
-//! motor (first-order speed lag, gain error, back-EMF current):
-//!   ψ' = ω_m,   ω_m' = (g_err·ω_full·duty − ω_m)/τ_m,   I = (V·duty − k_e ω_m)/R_a
-//! ```
-//! With ψ = ωt (constant speed) the pendulum equation is exactly SPEC §3's full equation
-//! θ'' = −ω0² sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − cθ' — `closed_loop_safety.rs`'s
-//! `plant_matches_the_full_equation` checks it. The pivot follows the motor, not the reference, so the
-//! phase lock matters. Sensors: the pendulum encoder quantises to 14 bits after Gaussian noise
-//! (xorshift64* + Box–Muller, seeded); the crank encoder to 4096 counts per turn.
+//! The closed-loop harness: the rig logic (`kapitza_core::rig::controller::Rig`) stepped in
+//! virtual time against the simulated rig's physics (`kapitza_core::simrig::plant`), with the
+//! test's own hand on the pendulum (`hold`) and its own schedule of link messages, which the
+//! product's `SimRig` (behind the full rig loop) does not offer. Sensors: the pendulum encoder
+//! quantises to 14 bits after Gaussian noise (`kapitza_core::sim::noise`, seeded); the crank
+//! encoder to 4096 counts per turn.
 
 #![allow(dead_code)]
 
-use kapitza_core::integrate::{rk4_step, Stats, System};
+use kapitza_core::integrate::{rk4_step, Stats};
 use kapitza_core::math;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::controller::{ControlReport, Rig};
 use kapitza_core::rig::estimator::Tuning;
 use kapitza_core::rig::fixed::{Amps, Angle, Duty};
 use kapitza_core::rig::phase_lock::Motor;
-
-/// Motor parameters of the simulated rig (deliberately not those the controller assumes).
-#[derive(Debug, Clone, Copy)]
-pub struct MotorModel {
-    /// True speed per unit duty is `gain_error`·ω_full: the feed-forward is 10 % off.
-    pub gain_error: f64,
-    pub omega_full: f64,
-    pub tau: f64,
-    pub volts: f64,
-    pub ke: f64,
-    pub ohms: f64,
-}
-
-impl MotorModel {
-    pub const DEFAULT: Self = Self {
-        gain_error: 0.9,
-        omega_full: 500.0,
-        tau: 0.06,
-        volts: 12.0,
-        ke: 12.0 / 500.0,
-        ohms: 2.0,
-    };
-}
-
-/// The pendulum and crank as one system, state [θ, θ', ψ, ω_m].
-#[derive(Debug, Clone, Copy)]
-pub struct Plant {
-    pub omega0_sq: f64,
-    pub ell: f64,
-    pub amplitude: f64,
-    pub damping: f64,
-    pub theta_d: f64,
-    pub motor: MotorModel,
-    pub duty: f64,
-    /// Crank jammed (for the stall test).
-    pub jammed: bool,
-}
-
-impl Plant {
-    fn motor_accel(&self, w: f64) -> f64 {
-        if self.jammed {
-            return 0.0;
-        }
-        (self.motor.gain_error * self.motor.omega_full * self.duty - w) / self.motor.tau
-    }
-}
-
-impl System<4> for Plant {
-    fn rhs(&self, _t: f64, y: &[f64; 4], dy: &mut [f64; 4]) {
-        let (sp, cp) = math::sin_cos(y[2]);
-        let w = y[3];
-        let wdot = self.motor_accel(w);
-        let s_dd = -self.amplitude * (w * w * cp + wdot * sp);
-        dy[0] = y[1];
-        dy[1] = -self.omega0_sq * math::sin(y[0])
-            + s_dd / self.ell * math::sin(y[0] - self.theta_d)
-            - self.damping * y[1];
-        dy[2] = w;
-        dy[3] = wdot;
-    }
-}
-
-/// xorshift64* with Box–Muller: reproducible noise without a dependency.
-#[derive(Debug, Clone, Copy)]
-pub struct Noise(u64);
-
-impl Noise {
-    pub fn new(seed: u64) -> Self {
-        Self(seed.max(1))
-    }
-    fn next_u64(&mut self) -> u64 {
-        let mut x = self.0;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    pub fn gaussian(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        math::sqrt(-2.0 * u.ln()) * math::cos(math::TAU * v)
-    }
-}
+use kapitza_core::sim::noise::Noise;
+use kapitza_core::simrig::plant::{MotorModel, Plant};
 
 /// Quantises an angle to `bits` per turn and returns it as an [`Angle`].
 pub fn quantise(theta: f64, bits: u32) -> Angle {
@@ -127,9 +34,7 @@ impl Motor for SimMotor<'_> {
         quantise(self.state[2], 12)
     }
     fn current(&mut self) -> Amps {
-        let m = &self.plant.motor;
-        let i = (m.volts * self.plant.duty - m.ke * self.state[3]) / m.ohms;
-        Amps::saturating_from_num(i)
+        Amps::saturating_from_num(self.plant.motor.current(self.plant.duty, self.state[3]))
     }
     fn set_duty(&mut self, duty: Duty) {
         self.plant.duty = duty.to_num();
@@ -166,7 +71,9 @@ impl Sim {
             omega0_sq: cfg.gravity / cfg.ell(),
             ell: cfg.ell(),
             amplitude: cfg.amplitude,
+            second: 0.0,
             damping,
+            coulomb: 0.0,
             theta_d: theta_d.to_rad(),
             motor: MotorModel::DEFAULT,
             duty: 0.0,

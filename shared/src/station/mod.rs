@@ -30,6 +30,8 @@
 //!
 //! **An unknown e-stop line counts as pressed**: the rig cannot start blind.
 
+pub mod selftest;
+
 use crate::link::frame::{decode_request_as, encode, open, Header};
 use crate::link::message::Counters;
 use crate::link::serve::{Clock, Effect, RigServer};
