@@ -173,7 +173,7 @@ pub fn run(
             }
         }
         if sim.seconds() >= wall.as_secs_f64() * speed {
-            std::thread::sleep(Duration::from_micros(500));
+            std::thread::sleep(Duration::from_millis(1));
         }
     }
     Ok(Summary {
