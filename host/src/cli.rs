@@ -22,6 +22,8 @@ pub enum Command {
     Boundary(cmd::boundary::Args),
     Simulate(cmd::simulate::Args),
     Bench(cmd::bench::Args),
+    Monitor(cmd::monitor::Args),
+    Demo(cmd::demo::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -78,6 +80,8 @@ where
         Command::Boundary(a) => cmd::boundary::run(&a, out)?,
         Command::Simulate(a) => cmd::simulate::run(&a, out)?,
         Command::Bench(a) => cmd::bench::run(&a, out)?,
+        Command::Monitor(a) => cmd::monitor::run(&a, out)?,
+        Command::Demo(a) => cmd::demo::run(&a, out)?,
     }
     Ok(())
 }

@@ -2,5 +2,7 @@
 
 pub mod bench;
 pub mod boundary;
+pub mod demo;
+pub mod monitor;
 pub mod predict;
 pub mod simulate;
