@@ -23,6 +23,7 @@ use serde::Serialize;
 
 use crate::monitor::predicted::predict;
 use crate::monitor::{Command, Driver, State};
+use crate::outcome::show_deg;
 
 /// Seconds of the rig's clock the rod hangs at rest before the first command.
 pub const REST_S: f64 = 3.0;
@@ -61,7 +62,8 @@ pub struct Outcome {
     pub r: f64,
     pub drive_angle_deg: f64,
     pub settled: bool,
-    /// Rig seconds from the command to the settled frame (the rest step: its length).
+    /// Rig seconds from the first frame after the command to the settled frame (the rest
+    /// step: its length).
     pub settle_s: Option<f64>,
     /// Measured: φ0 (at rest: the angle sample), ωp, R in situ.
     pub measured: Measured,
@@ -89,11 +91,12 @@ enum Phase {
     Rest {
         until_s: f64,
     },
-    /// Step `i` commanded at `since_s`; frames with `commands >= need` count.
+    /// Step `i` commanded; frames with `commands >= need` count, the first of them (taken
+    /// within a telemetry period of the rig carrying the command out) at `since_s`.
     Settling {
         i: usize,
         need: u32,
-        since_s: f64,
+        since_s: Option<f64>,
     },
     Stopping {
         need: u32,
@@ -168,6 +171,7 @@ impl Script {
             },
         };
         let show = |x: Option<f64>, prec: usize| x.map_or("—".into(), |v| format!("{v:.prec$}"));
+        let angle = |x: Option<f64>| x.map_or("—".into(), show_deg);
         state.note(format!(
             "R = {} at θd = {}°: {} — φ0 {} (predicted {}), ωp {} ({}), R {}",
             o.r,
@@ -177,8 +181,8 @@ impl Script {
                 Some(_) => "at rest".into(),
                 None => "did not settle".into(),
             },
-            show(o.measured.phi0_deg, 2),
-            show(o.predicted.phi0_deg, 2),
+            angle(o.measured.phi0_deg),
+            angle(o.predicted.phi0_deg),
             show(o.measured.omega_p, 3),
             show(o.predicted.omega_p, 3),
             show(o.measured.r, 3),
@@ -192,7 +196,11 @@ impl Script {
         let since_s = state.t_s();
         match STEPS.get(i) {
             Some(s) => {
-                self.pending = Some(Phase::Settling { i, need, since_s });
+                self.pending = Some(Phase::Settling {
+                    i,
+                    need,
+                    since_s: None,
+                });
                 Command::SetDrive {
                     r: s.r,
                     theta_d_deg: s.theta_d_deg,
@@ -228,6 +236,14 @@ impl Driver for Script {
                 if tm.commands < need {
                     return None;
                 }
+                let Some(since_s) = since_s else {
+                    self.phase = Phase::Settling {
+                        i,
+                        need,
+                        since_s: Some(t),
+                    };
+                    return None;
+                };
                 if tm.mode != Mode::Running {
                     let why = format!("the drive is no longer running (mode {:?})", tm.mode);
                     self.record(state, Some(STEPS[i]), since_s, false);

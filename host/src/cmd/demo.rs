@@ -8,6 +8,7 @@ use serde::Serialize;
 use crate::cmd::monitor::{open_feed, port_name};
 use crate::demo::{Outcome, Script};
 use crate::monitor::{self, Options, Plain};
+use crate::outcome::show_deg;
 
 /// Run the lecture demo: the rod hanging at rest; R = 1.75 at θd = 90°, where it settles near
 /// 55°; R = 2.2 with θd slewed to 180°, carrying it over the top; R = 1.75, where it stays
@@ -80,6 +81,7 @@ fn monitor_finished(script: &Script) -> bool {
 
 fn print_table(rows: &[Outcome], out: &mut dyn Write) -> Result<()> {
     let show = |x: Option<f64>, prec: usize| x.map_or("—".into(), |v| format!("{v:.prec$}"));
+    let angle = |x: Option<f64>| x.map_or("—".into(), show_deg);
     writeln!(
         out,
         "{:>5} {:>7}  {:>9}  {:>9} {:>9}  {:>9} {:>9}  {:>7} {:>7}",
@@ -92,8 +94,8 @@ fn print_table(rows: &[Outcome], out: &mut dyn Write) -> Result<()> {
             o.r,
             o.drive_angle_deg,
             show(o.settle_s, 1),
-            show(o.measured.phi0_deg, 2),
-            show(o.predicted.phi0_deg, 2),
+            angle(o.measured.phi0_deg),
+            angle(o.predicted.phi0_deg),
             show(o.measured.omega_p, 3),
             show(o.predicted.omega_p, 3),
             show(o.measured.r, 3),

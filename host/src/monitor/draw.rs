@@ -18,6 +18,12 @@ use ratatui::widgets::{Axis, Block, Chart, Dataset, GraphType, Paragraph};
 use ratatui::Frame;
 
 use super::state::{Link, Readings, State, HISTORY_S};
+use crate::outcome::show_deg;
+
+/// An angle in (−180°, 180°] as `predict` shows it, or a dash.
+fn angle(x: Option<f64>) -> String {
+    x.map_or("—".into(), show_deg)
+}
 
 /// A number with `prec` decimals, or a dash when there is none.
 fn num(x: Option<f64>, prec: usize) -> String {
@@ -127,14 +133,14 @@ fn pendulum_panel(r: Option<&Readings>) -> Paragraph<'static> {
     let lines = vec![
         Line::from(format!(" {:<14}{:>10} {:>10}", "", "measured", "predicted")).style(dim()),
         row(
-            "φ slow (°)",
-            num(r.map(|r| r.slow_angle_deg), 2),
-            num(r.and_then(|r| r.predicted_phi0_deg), 2),
+            "φ slow",
+            angle(r.map(|r| r.slow_angle_deg)),
+            angle(r.and_then(|r| r.predicted_phi0_deg)),
         ),
         row(
-            "φ0 (°)",
-            num(r.and_then(|r| r.equilibrium_deg), 2),
-            num(r.and_then(|r| r.predicted_phi0_deg), 2),
+            "φ0",
+            angle(r.and_then(|r| r.equilibrium_deg)),
+            angle(r.and_then(|r| r.predicted_phi0_deg)),
         ),
         row(
             "ωp (rad/s)",

@@ -229,3 +229,27 @@ fn key_of(code: KeyCode, mods: KeyModifiers) -> Option<Key> {
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ctrl_c_quits_and_never_clears_a_fault() {
+        assert_eq!(
+            key_of(KeyCode::Char('c'), KeyModifiers::CONTROL),
+            Some(Key::CtrlC)
+        );
+        assert_eq!(
+            key_of(KeyCode::Char('c'), KeyModifiers::NONE),
+            Some(Key::Char('c'))
+        );
+        // Caps lock or shift: the same keys.
+        assert_eq!(
+            key_of(KeyCode::Char('S'), KeyModifiers::SHIFT),
+            Some(Key::Char('s'))
+        );
+        assert_eq!(key_of(KeyCode::Esc, KeyModifiers::NONE), Some(Key::Esc));
+        assert_eq!(key_of(KeyCode::Enter, KeyModifiers::NONE), None);
+    }
+}

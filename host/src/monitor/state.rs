@@ -233,7 +233,9 @@ impl State {
         self.telemetry = Some(t);
         let Some(r) = self.readings() else { return };
         if r.settled && !was_settled {
-            let at = r.equilibrium_deg.map_or("—".into(), |d| format!("{d:.2}°"));
+            let at = r
+                .equilibrium_deg
+                .map_or("—".into(), crate::outcome::show_deg);
             self.note(format!("settled at φ0 = {at}"));
         }
         self.history.push_back(Point {
