@@ -236,6 +236,12 @@ impl Driver for Script {
                 if tm.commands < need {
                     return None;
                 }
+                if tm.mode != Mode::Running {
+                    let why = format!("the drive is no longer running (mode {:?})", tm.mode);
+                    self.record(state, Some(STEPS[i]), since_s.unwrap_or(t), false);
+                    self.abort(state, why);
+                    return None;
+                }
                 let Some(since_s) = since_s else {
                     self.phase = Phase::Settling {
                         i,
@@ -244,12 +250,6 @@ impl Driver for Script {
                     };
                     return None;
                 };
-                if tm.mode != Mode::Running {
-                    let why = format!("the drive is no longer running (mode {:?})", tm.mode);
-                    self.record(state, Some(STEPS[i]), since_s, false);
-                    self.abort(state, why);
-                    return None;
-                }
                 let done = tm.steady && tm.settled && tm.equilibrium.is_some();
                 let late = t - since_s > SETTLE_TIMEOUT_S;
                 if !(done || late) {

@@ -384,3 +384,107 @@ fn demo_settles_where_the_model_says() {
     assert!(steps[3]["measured"]["omega_p"].is_null(), "{}", steps[3]);
     assert!(steps[3]["measured"]["r"].is_null(), "{}", steps[3]);
 }
+
+#[test]
+fn a_rig_of_another_protocol_is_named_not_monitored() {
+    use kapitza_core::link::PROTOCOL_VERSION;
+    let mut feed = LinkFeed::spawn(Box::new(|| {
+        Ok(SimPort::new(demo_rig().speaking(PROTOCOL_VERSION + 1), 0.0))
+    }));
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let why = loop {
+        assert!(Instant::now() < deadline, "no word of the mismatch");
+        match feed.next_event(Duration::from_millis(100)) {
+            Some(Event::LinkLost(why)) => break why,
+            Some(Event::Linked { .. } | Event::Telemetry(_)) => panic!("linked to a v+1 rig"),
+            _ => {}
+        }
+    };
+    // Both versions and the fix, named.
+    let theirs = (PROTOCOL_VERSION + 1).to_string();
+    assert!(
+        why.contains(&theirs) && why.contains(&PROTOCOL_VERSION.to_string()),
+        "{why}"
+    );
+    assert!(why.contains("flash the firmware"), "{why}");
+}
+
+/// Feeds `frames` (with the demo rod's configuration) to the script; returns the commands it
+/// sent, each answered `Ok`.
+fn drive_script(
+    script: &mut kapitza::demo::Script,
+    s: &mut State,
+    frames: &[Telemetry],
+) -> Vec<Command> {
+    use kapitza::monitor::Driver;
+    let mut sent = Vec::new();
+    for f in frames {
+        s.on_event(Event::Telemetry(*f));
+        if let Some(c) = script.next(s) {
+            script.sent(s, c, &Ok(()));
+            sent.push(c);
+        }
+    }
+    sent
+}
+
+#[test]
+fn demo_script_waits_for_frames_after_its_command() {
+    use kapitza::demo::Script;
+    let cfg = Params::DEMO.configured();
+    let mut s = State::new();
+    s.on_event(Event::Linked {
+        protocol: 2,
+        firmware: [0, 1, 0],
+        config: cfg,
+    });
+    let mut script = Script::new();
+    let rest = |t: f64| Telemetry {
+        mode: Mode::Idle,
+        steady: false,
+        ..frame(t, 0.0, 0.0, 0.0, 0)
+    };
+    // 3 s at rest, then the first step.
+    let frames: Vec<Telemetry> = (0..=151).map(|k| rest(f64::from(k) * 0.02)).collect();
+    let sent = drive_script(&mut script, &mut s, &frames);
+    assert_eq!(
+        sent,
+        [Command::SetDrive {
+            r: 1.75,
+            theta_d_deg: 90.0
+        }]
+    );
+    assert_eq!(script.outcomes.len(), 1);
+    // Settled frames still carrying the old command count (taken before the command arrived)
+    // never end the step, however many.
+    let omega = cfg.omega_for_r(1.75).unwrap();
+    let stale: Vec<Telemetry> = (0..100)
+        .map(|k| frame(30.0 + f64::from(k) * 0.02, 55.2, omega, 90.0, 0))
+        .collect();
+    assert!(drive_script(&mut script, &mut s, &stale).is_empty());
+    assert_eq!(script.outcomes.len(), 1);
+    // Frames after the command: the first starts the clock, a settled one ends the step.
+    let fresh: Vec<Telemetry> = (0..3)
+        .map(|k| frame(40.0 + f64::from(k) * 0.02, 55.2, omega, 90.0, 1))
+        .collect();
+    let sent = drive_script(&mut script, &mut s, &fresh);
+    assert_eq!(
+        sent,
+        [Command::SetDrive {
+            r: 2.2,
+            theta_d_deg: 180.0
+        }]
+    );
+    let o = &script.outcomes[1];
+    assert!(o.settled && o.measured.phi0_deg.is_some());
+    // Settled on the second fresh frame: one telemetry period (20 ms) after the first.
+    assert!((o.settle_s.unwrap() - 0.02).abs() < 1e-6, "{o:?}");
+    // The drive stopped under the script (the stop key, a fault): the demo ends, saying why.
+    let stopped = Telemetry {
+        mode: Mode::Stopping(StopReason::Requested),
+        ..frame(41.0, 60.0, omega, 120.0, 3)
+    };
+    assert!(drive_script(&mut script, &mut s, &[stopped]).is_empty());
+    assert!(script.aborted.is_some());
+    assert!(!script.outcomes[2].settled);
+}
