@@ -138,9 +138,10 @@ pub struct State {
     /// Lines ever logged (the log drops old ones; writers of new lines count on this).
     pub logged: u64,
     pub quit: bool,
-    /// Rig seconds at the last frame, and its µs clock then (`None`: take the next frame as the
-    /// base, as after a reconnect to a rig whose clock restarted).
-    t_s: f64,
+    /// Rig µs since the first frame (summed exactly), and the rig's µs clock at the last frame
+    /// (`None`: take the next frame as the base, as after a reconnect to a rig whose clock
+    /// restarted).
+    elapsed_us: u64,
     last_us: Option<u32>,
     commands_seen: u32,
 }
@@ -163,7 +164,7 @@ impl State {
             log: VecDeque::new(),
             logged: 0,
             quit: false,
-            t_s: 0.0,
+            elapsed_us: 0,
             last_us: None,
             commands_seen: 0,
         }
@@ -171,7 +172,7 @@ impl State {
 
     /// Rig seconds since the first frame (carried across reconnects).
     pub fn t_s(&self) -> f64 {
-        self.t_s
+        self.elapsed_us as f64 * 1e-6
     }
 
     /// The largest command count the rig has reported: a frame with a larger one was taken
@@ -189,7 +190,7 @@ impl State {
         if self.log.len() == LOG_LINES {
             self.log.pop_front();
         }
-        self.log.push_back((self.t_s, text.into()));
+        self.log.push_back((self.t_s(), text.into()));
         self.logged += 1;
     }
 
@@ -224,7 +225,7 @@ impl State {
 
     fn on_telemetry(&mut self, t: Telemetry) {
         if let Some(last) = self.last_us {
-            self.t_s += f64::from(t.t_us.wrapping_sub(last)) * 1e-6;
+            self.elapsed_us += u64::from(t.t_us.wrapping_sub(last));
         }
         self.last_us = Some(t.t_us);
         self.commands_seen = self.commands_seen.max(t.commands);
@@ -300,7 +301,7 @@ impl State {
             .and_then(|(c, r)| predict(&c, r, drive_angle_deg));
         let mode = self.mode.unwrap_or(t.mode);
         Some(Readings {
-            t_s: self.t_s,
+            t_s: self.t_s(),
             mode: mode_label(mode),
             fault: mode_fault(mode).map(fault_label),
             r,
