@@ -6,7 +6,7 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 
 use crate::cmd::monitor::{open_feed, port_name};
-use crate::demo::{Outcome, Script};
+use crate::demo::{Outcome, Script, STEPS};
 use crate::monitor::{self, Options, Plain};
 use crate::outcome::show_deg;
 
@@ -68,15 +68,10 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     if script.outcomes.iter().any(|o| !o.settled) {
         bail!("a step did not settle");
     }
-    if !monitor_finished(&script) {
-        bail!("the demo did not finish");
+    if script.outcomes.len() != STEPS.len() + 1 {
+        bail!("the demo was left before its end");
     }
     Ok(())
-}
-
-/// Every step was measured (the run ended by the script, not by a quit key).
-fn monitor_finished(script: &Script) -> bool {
-    script.outcomes.len() == crate::demo::STEPS.len() + 1
 }
 
 fn print_table(rows: &[Outcome], out: &mut dyn Write) -> Result<()> {

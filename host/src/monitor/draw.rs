@@ -148,7 +148,7 @@ fn pendulum_panel(r: Option<&Readings>) -> Paragraph<'static> {
             num(r.and_then(|r| r.predicted_omega_p), 3),
         ),
         row(
-            "R (set: req.)",
+            "R in situ",
             num(r.and_then(|r| r.r_estimate), 3),
             num(r.and_then(|r| r.r_target), 3),
         ),

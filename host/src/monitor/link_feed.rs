@@ -126,9 +126,9 @@ fn io_thread<P: Read + Write>(
     let mut last_failure = String::new();
     loop {
         let why = match connect() {
-            Ok(port) => match session(Client::new(port), events, commands) {
-                End::Closed => return,
-                End::Lost(why) => {
+            Ok(port) => match run_session(&mut Client::new(port), events, commands) {
+                Ok(()) | Err(End::Closed) => return,
+                Err(End::Lost(why)) => {
                     if events.send(Event::LinkLost(why.clone())).is_err() {
                         return;
                     }
@@ -169,18 +169,8 @@ fn send(events: &SyncSender<Event>, e: Event) -> Result<(), End> {
     events.send(e).map_err(|_| End::Closed)
 }
 
-/// One connection, from the version check until the line fails or the monitor goes.
-fn session<P: Read + Write>(
-    mut client: Client<P>,
-    events: &SyncSender<Event>,
-    commands: &Receiver<(Command, Reply)>,
-) -> End {
-    match run_session(&mut client, events, commands) {
-        Ok(()) => End::Closed,
-        Err(e) => e,
-    }
-}
-
+/// One connection, from the version check until the line fails (`Err(Lost)`) or the monitor
+/// goes.
 fn run_session<P: Read + Write>(
     client: &mut Client<P>,
     events: &SyncSender<Event>,

@@ -47,10 +47,6 @@ impl SimPort {
             speed,
         }
     }
-
-    pub fn rig(&self) -> &SimRig {
-        &self.rig
-    }
 }
 
 impl Write for SimPort {
