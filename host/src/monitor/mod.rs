@@ -59,7 +59,8 @@ pub struct Options {
 /// What the loop off a terminal prints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Plain {
-    /// One JSON object per telemetry frame.
+    /// One JSON object per telemetry frame; the event log (a lost link, a mode change) goes to
+    /// stderr, so the records stay one kind of line.
     Records,
     /// The event log, line by line.
     Log,
@@ -158,24 +159,25 @@ pub fn run_plain(
 ) -> Result<State> {
     let mut s = Session::new(feed, driver, opts)?;
     let mut printed = 0;
+    let mut stderr = std::io::stderr();
     while !s.done() {
         let r = s.pump(Duration::from_millis(100))?;
-        match plain {
+        let log: &mut dyn Write = match plain {
             Plain::Records => {
                 if let Some(r) = r {
                     plain::json_line(&r, out)?;
                 }
+                &mut stderr
             }
-            Plain::Log => {
-                let new = (s.state.logged - printed) as usize;
-                let skip = s.state.log.len().saturating_sub(new);
-                for (t, line) in s.state.log.iter().skip(skip) {
-                    writeln!(out, "{t:9.2} s  {line}")?;
-                }
-                printed = s.state.logged;
-            }
-            Plain::Nothing => {}
+            Plain::Log => &mut *out,
+            Plain::Nothing => continue,
+        };
+        let new = (s.state.logged - printed) as usize;
+        let skip = s.state.log.len().saturating_sub(new);
+        for (t, line) in s.state.log.iter().skip(skip) {
+            writeln!(log, "{t:9.2} s  {line}")?;
         }
+        printed = s.state.logged;
     }
     s.finish()
 }
