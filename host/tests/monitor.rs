@@ -360,14 +360,14 @@ fn demo_settles_where_the_model_says() {
         let pred = s["predicted"]["phi0_deg"].as_f64().unwrap();
         assert!((pred.abs() - want).abs() < 1e-6, "{s}");
         let meas = s["measured"]["phi0_deg"].as_f64().unwrap();
-        // Measured within 0.5° of predicted (the demo's acceptance bound; the averaged theory itself
-        // differs from the full motion by O((A/ℓ)², (ω0/ω)²) ≈ 0.4 % here).
+        // Measured within 0.5° of predicted (the demo's acceptance bound; the averaged theory
+        // itself differs from the full motion by O((A/ℓ)², (ω0/ω)²) ≈ 0.4 % here).
         let d = (meas - pred + 180.0).rem_euclid(360.0) - 180.0;
         assert!(d.abs() < 0.5, "φ0 {meas} against {pred}: {s}");
     }
     for s in &steps[1..3] {
-        // R in situ within 2 % of R requested (the demo's acceptance bound), and ωp within 2 % of
-        // ω0 √(cos φ0 + R cos 2(φ0 − θd)) (SPEC §3).
+        // R in situ within 2 % of R requested (the demo's acceptance bound), and ωp within 2 %
+        // of ω0 √(cos φ0 + R cos 2(φ0 − θd)) (SPEC §3).
         let r = s["r"].as_f64().unwrap();
         let est = s["measured"]["r"].as_f64().expect("R in situ");
         assert!((est / r - 1.0).abs() < 0.02, "R {est} against {r}: {s}");
