@@ -31,6 +31,8 @@ pub enum Command {
     Config(cmd::config::Args),
     /// A simulated rig for serial clients.
     Rig(cmd::rig_serve::Args),
+    Monitor(cmd::monitor::Args),
+    Demo(cmd::demo::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -99,6 +101,8 @@ where
         Command::Clear(a) => cmd::stop::clear(&a, out)?,
         Command::Config(a) => cmd::config::run(&a, out)?,
         Command::Rig(a) => cmd::rig_serve::run(&a, out)?,
+        Command::Monitor(a) => cmd::monitor::run(&a, out)?,
+        Command::Demo(a) => cmd::demo::run(&a, out)?,
     }
     Ok(())
 }

@@ -6,8 +6,10 @@
 //! |---|---|
 //! | [`bench`] | `kapitza bench`: work-precision, the peer, the stability ladder, the physical question |
 //! | [`cli`] | parsing, dispatch, and the error type that picks the exit status |
+//! | [`demo`] | the lecture demo as a script over the monitor's feed, measured against predicted |
 //! | [`input`] | checks of command-line numbers |
 //! | [`link`] | the serial-link client: one method per command; "the line failed" apart from "the rig refused" |
+//! | [`monitor`] | the live monitor: feeds, state machine, dashboard, JSON/CSV records |
 //! | [`scene_file`] | scene files (TOML) and `--set` → the core's `Scene`, run options, `[expect]` |
 //! | [`outcome`] | the simulator's verdict in user terms, and `[expect]` judged against it |
 //! | [`record`] | what a run keeps for the output files, and its progress bar |
@@ -20,8 +22,10 @@ pub mod bench;
 pub mod cli;
 pub mod cmd;
 pub mod csv_out;
+pub mod demo;
 pub mod input;
 pub mod link;
+pub mod monitor;
 pub mod outcome;
 pub mod plot;
 pub mod record;

@@ -5,6 +5,8 @@ pub mod bench;
 pub mod boundary;
 pub mod config;
 pub mod ports;
+pub mod demo;
+pub mod monitor;
 pub mod predict;
 pub mod rig_args;
 pub mod rig_serve;
