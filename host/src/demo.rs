@@ -21,9 +21,9 @@
 use kapitza_core::link::message::Mode;
 use serde::Serialize;
 
-use crate::monitor::predicted::predict;
 use crate::monitor::{Command, Driver, State};
 use crate::outcome::show_deg;
+use crate::rig::predicted::predict;
 
 /// Seconds of the rig's clock the rod hangs at rest before the first command.
 pub const REST_S: f64 = 3.0;

@@ -1,17 +1,15 @@
 //! The monitor: the dashboard's snapshots (TestBackend), its keys as a state machine, the
-//! plain JSON records and the CSV log from the simulated rig, a lost and regained line, and
-//! the demo's script on the simulated demo rod.
+//! plain JSON records and the CSV log from the simulated rig, a rig of another protocol, and
+//! the demo's script on the simulated demo rod. (A lost and regained line is the port owner's,
+//! tested end to end in `rig_e2e.rs`.)
 //!
 //! Snapshots are text fixtures in `tests/fixtures/`; after a deliberate change to the
 //! dashboard, regenerate them with `KAPITZA_BLESS=1 cargo test -p kapitza --test monitor` and
 //! review the diff.
 
-use std::io::{self, Read, Write};
 use std::time::{Duration, Instant};
 
 use kapitza::monitor::draw::draw;
-use kapitza::monitor::link_feed::LinkFeed;
-use kapitza::monitor::simfeed::{demo_rig, SimPort};
 use kapitza::monitor::{Command, Event, Feed, Key, State};
 use kapitza_core::link::convert::to_q16;
 use kapitza_core::link::message::{Counters, Fault, Mode, RMethod, StopReason, Turns};
@@ -266,80 +264,6 @@ fn plain_records_and_csv() {
     assert!(rows.iter().all(|r| r.split(',').count() == header.len()));
 }
 
-/// A port that fails for good after `reads` reads, as an unplugged USB serial adapter does.
-struct Unplugged {
-    port: SimPort,
-    reads: u32,
-}
-
-impl Read for Unplugged {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        if self.reads == 0 {
-            return Err(io::ErrorKind::BrokenPipe.into());
-        }
-        self.reads -= 1;
-        self.port.read(buf)
-    }
-}
-
-impl Write for Unplugged {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.port.write(buf)
-    }
-    fn flush(&mut self) -> io::Result<()> {
-        Ok(())
-    }
-}
-
-#[test]
-fn a_lost_line_is_reported_and_regained() {
-    // First the rig, unplugged after 200 reads; then nothing there once; then the rig again.
-    let mut attempt = 0;
-    let mut feed = LinkFeed::spawn(Box::new(move || {
-        attempt += 1;
-        match attempt {
-            1 => Ok(Unplugged {
-                port: SimPort::new(demo_rig(), 0.0),
-                reads: 200,
-            }),
-            2 => Err("no such port".to_string()),
-            _ => Ok(Unplugged {
-                port: SimPort::new(demo_rig(), 0.0),
-                reads: u32::MAX,
-            }),
-        }
-    }));
-    let mut s = State::new();
-    let mut seen = Vec::new();
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while Instant::now() < deadline {
-        let Some(e) = feed.next_event(Duration::from_millis(100)) else {
-            continue;
-        };
-        let tag = match &e {
-            Event::Linked { .. } => "linked",
-            Event::LinkLost(_) => "lost",
-            Event::Note(_) => "note",
-            Event::Telemetry(_) => "telemetry",
-            Event::Status(_) => "status",
-        };
-        if seen.last() != Some(&tag) {
-            seen.push(tag);
-        }
-        s.on_event(e);
-        if seen.iter().filter(|t| **t == "linked").count() == 2 && tag == "telemetry" {
-            break;
-        }
-    }
-    let lost = seen.iter().position(|t| *t == "lost").expect("never lost");
-    let again = seen[lost..].iter().position(|t| *t == "linked");
-    assert!(again.is_some(), "never linked again: {seen:?}");
-    assert_eq!(seen.last(), Some(&"telemetry"), "{seen:?}");
-    assert!(s.log.iter().any(|(_, l)| l.contains("no such port")));
-    // Commands while the link is up are carried out.
-    assert_eq!(feed.command(Command::Stop), Ok(()));
-}
-
 #[test]
 fn demo_settles_where_the_model_says() {
     let mut out = Vec::new();
@@ -387,23 +311,20 @@ fn demo_settles_where_the_model_says() {
 
 #[test]
 fn a_rig_of_another_protocol_is_named_not_monitored() {
+    use kapitza::rig::file::RigFile;
+    use kapitza::rig::port::Target;
+    use kapitza::rig::simhost::SimOptions;
     use kapitza_core::link::PROTOCOL_VERSION;
-    let mut feed = LinkFeed::spawn(Box::new(|| {
-        Ok(SimPort::new(demo_rig().speaking(PROTOCOL_VERSION + 1), 0.0))
-    }));
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let why = loop {
-        assert!(Instant::now() < deadline, "no word of the mismatch");
-        match feed.next_event(Duration::from_millis(100)) {
-            Some(Event::LinkLost(why)) => break why,
-            Some(Event::Linked { .. } | Event::Telemetry(_)) => panic!("linked to a v+1 rig"),
-            _ => {}
-        }
+    let mut sim = SimOptions::new(RigFile::demo(), f64::INFINITY);
+    sim.protocol = Some(PROTOCOL_VERSION + 1);
+    let why = match kapitza::cmd::monitor::open_feed(&Target::Sim, &sim) {
+        Ok(_) => panic!("linked to a v+1 rig"),
+        Err(e) => format!("{e:#}"),
     };
     // Both versions and the fix, named.
-    let theirs = (PROTOCOL_VERSION + 1).to_string();
     assert!(
-        why.contains(&theirs) && why.contains(&PROTOCOL_VERSION.to_string()),
+        why.contains(&format!("v{}", PROTOCOL_VERSION + 1))
+            && why.contains(&format!("v{PROTOCOL_VERSION}")),
         "{why}"
     );
     assert!(why.contains("flash the firmware"), "{why}");

@@ -5,10 +5,12 @@ use std::io::{IsTerminal, Write};
 use anyhow::{bail, Result};
 use serde::Serialize;
 
-use crate::cmd::monitor::{open_feed, port_name};
+use crate::cmd::monitor::open_feed;
+use crate::cmd::rig_args::RigArgs;
 use crate::demo::{Outcome, Script, STEPS};
 use crate::monitor::{self, Options, Plain};
 use crate::outcome::show_deg;
+use crate::rig::port::Target;
 
 /// Run the lecture demo: the rod hanging at rest; R = 1.75 at θd = 90°, where it settles near
 /// 55°; R = 2.2 with θd slewed to 180°, carrying it over the top; R = 1.75, where it stays
@@ -19,11 +21,11 @@ use crate::outcome::show_deg;
 /// the monitor on a terminal.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// The rig: `sim` for the simulated demo rod in this process. Default: $KAPITZA_PORT, else
-    /// `sim`.
+    /// The rig to run it on (a device path, or `auto` for the one ST-LINK attached). Default:
+    /// the simulated demo rod in this process.
     #[arg(long, value_name = "P")]
     pub port: Option<String>,
-    /// The simulated rig's pace: X times real time (0: as fast as the machine goes).
+    /// The simulated rig's pace: X times real time (0: as fast as the demo reads).
     #[arg(long, value_name = "X", default_value_t = 1.0)]
     pub speed: f64,
     /// Progress lines and the table instead of the dashboard.
@@ -43,7 +45,13 @@ pub struct Report<'a> {
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
-    let mut feed = open_feed(&port_name(&args.port), args.speed)?;
+    let rig = RigArgs {
+        port: Some(args.port.clone().unwrap_or_else(|| "sim".into())),
+        sim: None,
+        speed: args.speed,
+    };
+    let target: Target = rig.target()?;
+    let mut feed = open_feed(&target, &rig.sim_options()?)?;
     let mut script = Script::new();
     let opts = Options::default();
     if args.json {

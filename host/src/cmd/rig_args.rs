@@ -19,7 +19,7 @@ pub struct RigArgs {
     /// With `--port sim`: the simulated rig's file (default: the demo rod, rigs/demo.toml).
     #[arg(long, value_name = "FILE")]
     pub sim: Option<PathBuf>,
-    /// With `--port sim`: rig seconds per wall second.
+    /// With `--port sim`: rig seconds per wall second (0: as fast as the laptop reads).
     #[arg(long, default_value_t = 1.0, value_name = "X")]
     pub speed: f64,
 }
@@ -34,7 +34,10 @@ impl RigArgs {
             Some(p) => file::load(p)?,
             None => RigFile::demo(),
         };
-        let speed = crate::input::positive("--speed", self.speed)?;
+        let speed = match crate::input::non_negative("--speed", self.speed)? {
+            0.0 => f64::INFINITY,
+            x => x,
+        };
         Ok(SimOptions::new(rig, speed))
     }
 

@@ -169,7 +169,7 @@ fn stage(t: &Telemetry) -> &'static str {
 
 /// One line of what the rig does.
 fn progress_line(t: &Telemetry) -> String {
-    use crate::rig::session::turns_deg;
+    use crate::rig::names::turns_deg;
     use kapitza_core::link::convert::from_q16;
     let phi = match (t.settled, t.equilibrium) {
         (true, Some(e)) => turns_deg(e),

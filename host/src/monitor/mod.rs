@@ -5,9 +5,7 @@
 //! | module | concept |
 //! |---|---|
 //! | [`feed`] | what the monitor reads ([`Event`]) and may ask ([`Command`]), and the [`Feed`] trait |
-//! | [`link_feed`] | a feed over the link client on an I/O thread: keep-alive, reconnects |
-//! | [`simfeed`] | the simulated demo rig as a port paced against the wall clock |
-//! | [`predicted`] | the averaged theory's φ0 and ωp for the configured pendulum (`predict`'s code) |
+//! | [`owner_feed`] | a feed over the port's owner ([`crate::rig::owner`]) on its own thread: keep-alive, control socket, reconnects |
 //! | [`state`] | the state machine fed by events and keys; the numbers of a frame ([`Readings`]) |
 //! | [`draw`] | the dashboard drawn from the state alone |
 //! | [`plain`] | JSON per frame and the CSV log |
@@ -21,10 +19,8 @@
 
 pub mod draw;
 pub mod feed;
-pub mod link_feed;
+pub mod owner_feed;
 pub mod plain;
-pub mod predicted;
-pub mod simfeed;
 pub mod state;
 
 use std::fs::File;

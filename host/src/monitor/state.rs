@@ -7,13 +7,13 @@ use std::collections::VecDeque;
 use serde::Serialize;
 
 use kapitza_core::link::convert::from_q16;
-use kapitza_core::link::message::{Fault, Mode, StopReason, Turns};
+use kapitza_core::link::message::{Fault, Mode, StopReason};
 use kapitza_core::link::{Status, Telemetry};
-use kapitza_core::math;
 use kapitza_core::rig::config::RigConfig;
 
 use super::feed::{Command, Event};
-use super::predicted::predict;
+use crate::rig::names::{fault_name, mode_name, turns_deg};
+use crate::rig::predicted::predict;
 
 /// Seconds of slow angle the chart keeps.
 pub const HISTORY_S: f64 = 60.0;
@@ -87,33 +87,11 @@ pub struct Readings {
     pub commands: u32,
 }
 
-/// Turns (2^32 per turn) as degrees in (−180, 180].
-pub fn turns_deg(t: Turns) -> f64 {
-    math::wrap_deg(f64::from(t) * (360.0 / 4_294_967_296.0))
-}
-
 /// An angle as the chart shows it, in [−90°, 270°): every equilibrium reachable within the
 /// mount's travel (θd in [−10°, 190°], φ0 within 90° of it) stays clear of the chart's edges, so
 /// a rod carried over the top draws as one curve instead of jumping between ±180°.
 pub fn chart_deg(deg: f64) -> f64 {
     (deg + 90.0).rem_euclid(360.0) - 90.0
-}
-
-pub fn mode_label(m: Mode) -> &'static str {
-    match m {
-        Mode::Idle => "idle",
-        Mode::Running => "running",
-        Mode::Stopping(_) => "stopping",
-        Mode::Faulted(_) => "faulted",
-    }
-}
-
-pub fn fault_label(f: Fault) -> &'static str {
-    match f {
-        Fault::EStop => "e_stop",
-        Fault::OverCurrent => "over_current",
-        Fault::Stall => "stall",
-    }
 }
 
 fn mode_fault(m: Mode) -> Option<Fault> {
@@ -255,8 +233,8 @@ impl State {
 
     fn set_mode(&mut self, m: Mode) {
         if self.mode != Some(m) {
-            let fault = mode_fault(m).map_or(String::new(), |f| format!(" ({})", fault_label(f)));
-            self.note(format!("mode: {}{fault}", mode_label(m)));
+            let fault = mode_fault(m).map_or(String::new(), |f| format!(" ({})", fault_name(&f)));
+            self.note(format!("mode: {}{fault}", mode_name(&m)));
             self.mode = Some(m);
         }
     }
@@ -302,8 +280,8 @@ impl State {
         let mode = self.mode.unwrap_or(t.mode);
         Some(Readings {
             t_s: self.t_s(),
-            mode: mode_label(mode),
-            fault: mode_fault(mode).map(fault_label),
+            mode: mode_name(&mode),
+            fault: mode_fault(mode).map(|f| fault_name(&f)),
             r,
             r_target: cfg.zip(omega_target).map(|(c, w)| c.r_for_omega(w)),
             omega,

@@ -6,15 +6,19 @@
 //! | [`port`] | `--port`: a device, `auto` (the one ST-LINK), `sim`; listing ports; opening one |
 //! | [`file`] | rig files: a simulated rig's true physics and the configuration it is given |
 //! | [`simhost`] | a simulated rig against the wall clock (real time × speed), on any line |
+//! | [`predicted`] | what the model expects of the configured pendulum at a drive (the `predict` code) |
 //! | [`session`] | a checked connection (version, configuration) and the rig's state in user units |
+//! | [`names`] | modes, faults and stop reasons as every output names them; wire angles in degrees |
 //! | [`owner`] | the process that owns a port serves a control socket; one-shot commands use it |
 //!
 //! Exit statuses of the rig commands: 0 done, 1 refused, 2 usage, 3 no rig / the line failed,
 //! 4 `--wait` timed out ([`Exit`]).
 
 pub mod file;
+pub mod names;
 pub mod owner;
 pub mod port;
+pub mod predicted;
 pub mod session;
 pub mod simhost;
 

@@ -8,7 +8,7 @@
 //! one-shot command ──frames──▶ control socket ──▶ owner ──Client──▶ serial port ──▶ rig
 //!                  ◀──answer (its own seq) ───────────────◀ answer ◀───────────────
 //!                  ◀──telemetry, when it asked for it ─────◀ the owner's own stream
-//! the owner: GetStatus every 250 ms (the keep-alive), telemetry every 50 ms; a lost line is
+//! the owner: GetStatus every 250 ms (the keep-alive), telemetry every 20 ms; a lost line is
 //! reopened at the same path, its version checked again
 //! ```
 
@@ -32,7 +32,7 @@ use crate::link::{Error, LineError};
 /// The keep-alive period: well inside the rig's 1 s link timeout.
 const KEEP_ALIVE: Duration = Duration::from_millis(250);
 /// The owner's telemetry period (ms).
-const TELEMETRY_MS: u16 = 50;
+const TELEMETRY_MS: u16 = 20;
 /// How often a lost line is tried again.
 const REOPEN_EVERY: Duration = Duration::from_millis(500);
 

@@ -6,18 +6,17 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use kapitza_core::link::convert::from_q16;
-use kapitza_core::link::message::{Fault, Mode, StopReason};
+use kapitza_core::link::message::Mode;
 use kapitza_core::link::{Status, Telemetry, VersionInfo, PROTOCOL_VERSION};
-use kapitza_core::math;
-use kapitza_core::model::{equilibria, DriveAngle};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
-use kapitza_core::rig::fixed::Angle;
 use serde::Serialize;
 
+use super::names::{fault_name, mode_name, stop_name, turns_deg};
 use super::owner;
 use super::port::{self, ReadWrite, Target};
-use super::simhost::{mode_name, SimOptions, SimPort};
+use super::predicted::{predict, Prediction};
+use super::simhost::{SimOptions, SimPort};
 use super::{Exit, Failure};
 use crate::link::{Client, Error, LineError};
 
@@ -137,32 +136,6 @@ impl Session {
     }
 }
 
-/// The model's answer for the drive the rig is set to: the stable equilibrium within 90° of
-/// the drive nearest `near` (rad), and its ωp.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Predicted {
-    pub phi0_deg: f64,
-    pub omega_p: f64,
-}
-
-/// The equilibrium `predict` gives for R and θd on the configured pendulum.
-pub fn predicted(cfg: &RigConfig, r: f64, theta_d_deg: f64, near: f64) -> Option<Predicted> {
-    let d = DriveAngle::from_deg(theta_d_deg).ok()?;
-    let eq = equilibria(r, d).ok()?;
-    let best = eq
-        .stable()
-        .filter(|e| math::wrap_pi(e.angle - d.rad()).abs() <= math::FRAC_PI_2 + 1e-9)
-        .min_by(|a, b| {
-            let da = math::wrap_pi(a.angle - near).abs();
-            let db = math::wrap_pi(b.angle - near).abs();
-            da.total_cmp(&db)
-        })?;
-    Some(Predicted {
-        phi0_deg: math::to_deg(best.angle),
-        omega_p: cfg.omega0() * math::sqrt(best.margin.max(0.0)),
-    })
-}
-
 /// The rig's state as `status --json`, `set --json` and the monitor print it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StatusView {
@@ -188,7 +161,7 @@ pub struct StatusView {
     pub r_estimate: Option<f64>,
     pub settled: bool,
     /// The model's φ0 and ωp for `r_target` and `drive_angle_target_deg` (while running).
-    pub predicted: Option<Predicted>,
+    pub predicted: Option<Prediction>,
     /// Commands the rig has carried out since power-up.
     pub commands: u32,
     /// Where the rig's configuration came from.
@@ -199,27 +172,6 @@ pub struct StatusView {
     pub frames_dropped: u32,
     pub sensor_errors: u32,
     pub overruns: u32,
-}
-
-fn fault_name(f: &Fault) -> &'static str {
-    match f {
-        Fault::EStop => "estop",
-        Fault::OverCurrent => "over_current",
-        Fault::Stall => "stall",
-    }
-}
-
-fn stop_name(s: &StopReason) -> &'static str {
-    match s {
-        StopReason::Requested => "requested",
-        StopReason::LinkSilent => "link_silent",
-        StopReason::Fault(f) => fault_name(f),
-    }
-}
-
-/// A wire angle (2^32 per turn) in degrees, in (−180, 180].
-pub fn turns_deg(t: i32) -> f64 {
-    math::wrap_deg(Angle::from_bits(t).to_deg())
 }
 
 impl StatusView {
@@ -233,14 +185,7 @@ impl StatusView {
             _ => turns_deg(t.phi),
         });
         let predicted = (s.mode == Mode::Running && r_target > 0.0)
-            .then(|| {
-                predicted(
-                    cfg,
-                    r_target,
-                    theta_d_target,
-                    math::to_rad(slow.unwrap_or(0.0)),
-                )
-            })
+            .then(|| predict(cfg, r_target, theta_d_target))
             .flatten();
         Self {
             mode: mode_name(&s.mode),

@@ -20,7 +20,6 @@ use std::sync::mpsc::{
 use std::time::{Duration, Instant};
 
 use kapitza_core::link::convert::deg_along_travel;
-use kapitza_core::link::message::Mode;
 use kapitza_core::link::serve::RigServer;
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::dds::omega_of_word;
@@ -28,6 +27,7 @@ use kapitza_core::simrig::SimRig;
 use serde::Serialize;
 
 use super::file::RigFile;
+use super::names::mode_name;
 
 /// At most this much rig time (s) between two looks at the line.
 const MAX_BATCH: f64 = 0.005;
@@ -39,7 +39,8 @@ pub const FIRMWARE: [u16; 3] = [0, 1, 0];
 #[derive(Debug, Clone)]
 pub struct SimOptions {
     pub rig: RigFile,
-    /// Rig seconds per wall second; `f64::INFINITY`: as fast as the machine goes.
+    /// Rig seconds per wall second; `f64::INFINITY`: as fast as the laptop reads (the rig
+    /// waits while its bytes wait, so nothing is dropped).
     pub speed: f64,
     /// Speak another link protocol version (for tests of version skew).
     pub protocol: Option<u8>,
@@ -103,16 +104,6 @@ impl Applied {
     }
 }
 
-/// The mode's name in every JSON output.
-pub fn mode_name(m: &Mode) -> &'static str {
-    match m {
-        Mode::Idle => "idle",
-        Mode::Running => "running",
-        Mode::Stopping(_) => "stopping",
-        Mode::Faulted(_) => "faulted",
-    }
-}
-
 /// What a run did.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Summary {
@@ -154,8 +145,16 @@ pub fn run(
                 w.flush()?;
             }
         }
-        let due = (wall.as_secs_f64() * speed).min(sim.seconds() + MAX_BATCH);
+        let unpaced = speed.is_infinite();
+        let due = if unpaced {
+            sim.seconds() + MAX_BATCH
+        } else {
+            (wall.as_secs_f64() * speed).min(sim.seconds() + MAX_BATCH)
+        };
         while sim.seconds() < due {
+            if unpaced && (out_from != out_to || sim.rig().pending() > 0) {
+                break;
+            }
             sim.step(link_us);
         }
         loop {
@@ -172,7 +171,12 @@ pub fn run(
                 break;
             }
         }
-        if sim.seconds() >= wall.as_secs_f64() * speed {
+        let waiting = if unpaced {
+            out_from != out_to
+        } else {
+            sim.seconds() >= wall.as_secs_f64() * speed
+        };
+        if waiting {
             std::thread::sleep(Duration::from_millis(1));
         }
     }

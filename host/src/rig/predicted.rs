@@ -14,7 +14,7 @@ use crate::cmd::predict::{self, Args};
 use crate::input::GeometryArgs;
 
 /// The reachable stable equilibrium and its slow frequency.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Prediction {
     /// φ0 in (−180°, 180°].
     pub phi0_deg: f64,
