@@ -110,10 +110,7 @@ impl Feed for OwnerFeed {
         if let Some(e) = self.early.pop_front() {
             return Some(e);
         }
-        match self.events.recv_timeout(timeout) {
-            Ok(e) => Some(e),
-            Err(RecvTimeoutError::Timeout | RecvTimeoutError::Disconnected) => None,
-        }
+        self.events.recv_timeout(timeout).ok()
     }
 
     fn command(&mut self, c: Command) -> Result<(), String> {
