@@ -7,10 +7,9 @@
 //! dashboard, regenerate them with `KAPITZA_BLESS=1 cargo test -p kapitza --test monitor` and
 //! review the diff.
 
-use std::time::{Duration, Instant};
 
 use kapitza::monitor::draw::draw;
-use kapitza::monitor::{Command, Event, Feed, Key, State};
+use kapitza::monitor::{Command, Event, Key, State};
 use kapitza_core::link::convert::to_q16;
 use kapitza_core::link::message::{Counters, Fault, Mode, RMethod, StopReason, Turns};
 use kapitza_core::link::{Status, Telemetry};
