@@ -238,7 +238,7 @@ impl<P: Read + Write> Client<P> {
     /// Reads what has arrived. Returns the answer to `seq` (or a link-level refusal of a frame
     /// the rig could not read, seq 0), queues telemetry, drops everything else.
     fn poll(&mut self, seq: u8) -> Result<Option<Response>, Error> {
-        let mut buf = [0u8; 64];
+        let mut buf = [0u8; 512];
         let n = match self.port.read(&mut buf) {
             Ok(n) => n,
             Err(e)

@@ -7,7 +7,6 @@
 //! dashboard, regenerate them with `KAPITZA_BLESS=1 cargo test -p kapitza --test monitor` and
 //! review the diff.
 
-
 use kapitza::monitor::draw::draw;
 use kapitza::monitor::{Command, Event, Key, State};
 use kapitza_core::link::convert::to_q16;

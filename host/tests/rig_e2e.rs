@@ -72,7 +72,17 @@ impl Running {
 }
 
 impl Drop for Running {
+    /// Ctrl-C first, so a server removes its symlink and an owner its socket; then a kill.
     fn drop(&mut self) {
+        // SAFETY: kill(2) on our own child's pid.
+        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
+        let deadline = Instant::now() + Duration::from_secs(2);
+        while Instant::now() < deadline {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
@@ -240,16 +250,17 @@ fn a_restarted_rig_is_found_again_on_its_symlink() {
     drop(first);
     std::thread::sleep(Duration::from_millis(500));
     let second = serve(&["--link", link]);
-    // The owner reopens the same path and checks the version again.
+    // The owner reopens the same path, checks the version again and serves its socket again
+    // (while the line is lost it has none, so commands then reach the rig directly).
     let deadline = Instant::now() + Duration::from_secs(20);
     let mut ok = false;
     while Instant::now() < deadline {
-        let o = kapitza(&["status", "--port", link, "--json"]);
-        if o.status.success() && String::from_utf8_lossy(&o.stdout).contains("\"mode\"") {
+        std::thread::sleep(Duration::from_millis(300));
+        let o = kapitza(&["status", "--port", link]);
+        if o.status.success() && String::from_utf8_lossy(&o.stdout).contains("through its owner") {
             ok = true;
             break;
         }
-        std::thread::sleep(Duration::from_millis(200));
     }
     let printed = owner.interrupt();
     assert!(ok, "status never answered through the owner again");
@@ -448,4 +459,111 @@ fn soak_noisy_line() {
     let [sent, ok, refused, failed, wrong] = noisy_run(2000, 11, 400);
     println!("soak: sent {sent}, carried out {ok}, refused {refused}, failed clearly {failed}, wrong {wrong}");
     assert_eq!(wrong, 0);
+}
+
+#[test]
+fn no_port_and_none_found_gives_the_hint() {
+    // No --port, no KAPITZA_PORT, and (on a machine without a board) no ST-LINK port.
+    let ports = json(&kapitza(&["ports", "--json"]));
+    if ports
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|p| p["stlink"] == true)
+    {
+        return;
+    }
+    let o = kapitza(&["status"]);
+    assert_eq!(o.status.code(), Some(3));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("--port sim") && e.contains("kapitza ports"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_monitor_prints_records_from_a_served_rig() {
+    let rig = serve(&[]);
+    let o = kapitza(&[
+        "monitor",
+        "--port",
+        &rig.first_line,
+        "--plain",
+        "--duration",
+        "1",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let text = String::from_utf8_lossy(&o.stdout);
+    let records: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    // 1 s of rig time at a frame every 20 ms is about 50 records (the first ones as the link
+    // comes up may be fewer).
+    assert!(records.len() >= 40, "{} records", records.len());
+    assert!(records
+        .iter()
+        .all(|r| r["mode"] == "idle" && r["settled"].is_boolean()));
+}
+
+#[test]
+fn configuration_round_trip_and_refusal_by_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = serve(&[]);
+    let port = rig.first_line.as_str();
+    let got = kapitza(&["config", "get", "--port", port]);
+    assert!(got.status.success());
+    let toml = String::from_utf8_lossy(&got.stdout).to_string();
+    // The demo rod's configuration (rigs/demo.toml): A = 12.7 mm on a 0.25 m rod.
+    assert!(
+        toml.contains("amplitude = 0.0127") && toml.contains("length = 0.25"),
+        "{toml}"
+    );
+    // A value out of range: refused here with its field and range, nothing sent.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[limits]\nstall_fraction = 3.0\n").unwrap();
+    let o = kapitza(&["config", "set", "--port", port, bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("stall_fraction") && e.contains("(0, 1]"), "{e}");
+    // A partial file: only the amplitude changes.
+    let new = dir.path().join("new.toml");
+    std::fs::write(&new, "amplitude = 0.012\n").unwrap();
+    let o = kapitza(&["config", "set", "--port", port, new.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v = json(&kapitza(&["config", "get", "--port", port, "--json"]));
+    assert_eq!(v["amplitude"], 0.012);
+    assert_eq!(v["pendulum"]["length"], 0.25);
+    let s = json(&kapitza(&["status", "--port", port, "--json"]));
+    assert_eq!(s["config"], "received, saved");
+    // While the drive runs (an owner keeps it running), another configuration is refused by
+    // the rig and nothing changes.
+    let owner = start(&["attach", "--port", port]);
+    let o = kapitza(&["set", "--port", port, "--r", "1", "--angle", "0"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let other = dir.path().join("other.toml");
+    std::fs::write(&other, "amplitude = 0.011\n").unwrap();
+    let o = kapitza(&["config", "set", "--port", port, other.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("refused") && e.contains("Running"), "{e}");
+    let v = json(&kapitza(&["config", "get", "--port", port, "--json"]));
+    assert_eq!(v["amplitude"], 0.012);
+    owner.interrupt();
 }

@@ -33,6 +33,8 @@ use crate::link::{Error, LineError};
 const KEEP_ALIVE: Duration = Duration::from_millis(250);
 /// The owner's telemetry period (ms).
 const TELEMETRY_MS: u16 = 20;
+/// Telemetry frames taken per turn at most.
+const TELEMETRY_BATCH: usize = 16;
 /// How often a lost line is tried again.
 const REOPEN_EVERY: Duration = Duration::from_millis(500);
 
@@ -68,6 +70,9 @@ pub fn connect(port: &str) -> Option<UnixStream> {
     Some(s)
 }
 
+/// Socket clients are numbered across every socket this process serves.
+static NEXT_CLIENT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// A request from a socket client, to be relayed.
 struct Job {
     client: usize,
@@ -95,7 +100,9 @@ pub struct Owner {
     session: Option<Session>,
     socket: Option<PathBuf>,
     jobs: Receiver<Job>,
+    job_tx: Sender<Job>,
     clients: Receiver<(usize, UnixStream)>,
+    client_tx: Sender<(usize, UnixStream)>,
     writers: Vec<(usize, UnixStream, bool)>,
     next_alive: Instant,
     next_reopen: Instant,
@@ -108,7 +115,7 @@ impl Owner {
         let (job_tx, jobs) = mpsc::channel();
         let (client_tx, clients) = mpsc::channel();
         let socket = match &target {
-            Target::Serial { path } => Some(listen(path, job_tx, client_tx)?),
+            Target::Serial { path } => Some(listen(path, job_tx.clone(), client_tx.clone())?),
             Target::Sim => None,
         };
         let mut o = Self {
@@ -117,7 +124,9 @@ impl Owner {
             session: Some(session),
             socket,
             jobs,
+            job_tx,
             clients,
+            client_tx,
             writers: Vec::new(),
             next_alive: Instant::now(),
             next_reopen: Instant::now(),
@@ -155,6 +164,10 @@ impl Owner {
                 self.next_reopen = Instant::now() + REOPEN_EVERY;
                 if let Ok(s) = session::open(&self.target, &self.sim) {
                     self.session = Some(s);
+                    if let Target::Serial { path } = &self.target {
+                        self.socket =
+                            listen(path, self.job_tx.clone(), self.client_tx.clone()).ok();
+                    }
                     if self.stream().is_ok() {
                         events.push(Event::LinkBack);
                     }
@@ -177,7 +190,12 @@ impl Owner {
                 None => {}
             }
         }
-        while let Some(s) = self.session.as_mut() {
+        // A bounded batch: a rig faster than real time streams a frame every millisecond, and
+        // requests must not wait behind them.
+        for _ in 0..TELEMETRY_BATCH {
+            let Some(s) = self.session.as_mut() else {
+                break;
+            };
             match s.client.telemetry_now() {
                 Ok(Some(t)) => {
                     self.fan_out(&Response::Telemetry(t));
@@ -219,6 +237,12 @@ impl Owner {
         }
         self.session = None;
         self.next_reopen = Instant::now() + REOPEN_EVERY;
+        // No socket while there is no rig behind it: the device name may come back as
+        // another rig's (a pseudo-terminal's number is reused), whose commands must not
+        // reach this owner.
+        if let Some(p) = self.socket.take() {
+            let _ = std::fs::remove_file(p);
+        }
         events.push(Event::LinkLost(e.to_string()));
     }
 
@@ -300,7 +324,8 @@ fn listen(port: &str, jobs: Sender<Job>, clients: Sender<(usize, UnixStream)>) -
     let listener = UnixListener::bind(&path)
         .with_context(|| format!("cannot open the control socket {}", path.display()))?;
     std::thread::spawn(move || {
-        for (id, stream) in listener.incoming().flatten().enumerate() {
+        for stream in listener.incoming().flatten() {
+            let id = NEXT_CLIENT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let Ok(writer) = stream.try_clone() else {
                 continue;
             };
