@@ -6,25 +6,12 @@
 //! attractor of the same equation, and coulomb-stick because its resting angle depends on
 //! where the pendulum happens to stop within the sticking band).
 
+mod shipped;
+
 use serde_json::Value;
 
 fn run(file: &str, angle_deg: f64) -> Value {
-    let path = format!("{}/../scenes/{file}", env!("CARGO_MANIFEST_DIR"));
-    let set = format!("drive.angle_deg={angle_deg}");
-    let mut out = Vec::new();
-    kapitza::run(
-        [
-            "kapitza",
-            "simulate",
-            path.as_str(),
-            "--set",
-            set.as_str(),
-            "--json",
-        ],
-        &mut out,
-    )
-    .unwrap_or_else(|e| panic!("{file} at {angle_deg}°: {e}"));
-    serde_json::from_slice(&out).unwrap()
+    shipped::simulate(file, &[&format!("drive.angle_deg={angle_deg}")])
 }
 
 /// Angle difference in degrees, wrapped to [−180, 180).

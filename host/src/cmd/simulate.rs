@@ -41,7 +41,7 @@ pub struct Args {
     pub check: bool,
     /// Time-series samples per drive period for series.csv and the plots (at most 200 000
     /// samples in all: long runs are sampled more sparsely).
-    #[arg(long, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", default_value_t = 20, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub samples_per_period: u32,
 }
 

@@ -6,6 +6,7 @@
 //! | [`signal`] | the drive: pivot acceleration and phase, with ramp, motor lag, slider-crank |
 //! | [`eom`] | full, averaged and linearised equations, composed from the listed effects |
 //! | [`fidelity`] | which equation a scene runs (`auto`: the cheapest valid one) and why |
+//! | [`wobble`] | the fast wobble: full state to the averaged model's slow state and back |
 //! | [`classify`] | the outcome from stroboscopic samples |
 //! | [`sampling`] | strobes, period means, output and sensor samples between steps |
 //! | [`sensor`] | the pivot encoder: sampled, noisy, quantised |
@@ -25,6 +26,7 @@ pub mod scene;
 pub mod sensor;
 pub mod signal;
 mod turns;
+pub mod wobble;
 
 pub use classify::Outcome;
 pub use run::{simulate, Format, Method, Options, Report, SimError};

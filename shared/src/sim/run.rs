@@ -17,6 +17,7 @@ use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
 use super::turns::{Shifted, Turns};
+use super::wobble::Wobble;
 use crate::integrate::{
     rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
     StepControl, Symplectic, System,
@@ -94,7 +95,8 @@ pub struct Report {
     pub work: Stats,
     /// Work of the Lyapunov run, when the classifier needed one.
     pub lyapunov_work: Stats,
-    /// Final time, angle (rad, unwrapped) and rate (rad/s).
+    /// Final time, angle (rad, unwrapped) and rate (rad/s). From the averaged model: the full
+    /// state read back from the slow one ([`super::wobble`]).
     pub end: (f64, f64, f64),
     /// With Coulomb friction: how many times the pendulum stuck.
     pub sticks: Option<u64>,
@@ -270,9 +272,25 @@ fn run_format<R: Real, Rec: Recorder>(
     let t_end = scene.duration(p.omega);
     // `periods = 4000` must give 4000 strobes, not 3999 through rounding of ω·t_end/2π.
     let strobes_total = libm::floor(sched.state(t_end).phase / math::TAU + 1e-9) as u64;
+    let wobble = (decision.fidelity == Fidelity::Averaged).then(|| Wobble {
+        a1: p.amplitude / p.ell,
+        a2: second_harmonic(scene, p),
+        omega: p.omega,
+        c: p.c,
+        angle: scene.drive.angle,
+    });
+    let given = (scene.initial_angle, scene.initial_rate);
+    // The averaged model starts from the slow state under the given full one. A ramped or
+    // lagging drive starts at rest, with no wobble to take out.
+    let y0 = match wobble {
+        Some(w) if scene.effects.ramp.is_none() && scene.effects.actuator.is_none() => {
+            w.slow(given, 0.0)
+        }
+        _ => given,
+    };
     let ctx = Context {
         method: options.method,
-        y0: (scene.initial_angle, scene.initial_rate),
+        y0,
         t_end,
         schedule: sched,
         strobes_total,
@@ -285,12 +303,28 @@ fn run_format<R: Real, Rec: Recorder>(
         periodic: decision.fidelity != Fidelity::Linearised,
     };
     let a1 = p.amplitude / p.ell;
-    if shaped(scene) {
+    let mut report = if shaped(scene) {
         let sig = Shaped::<R>::new(a1, second_harmonic(scene, p), sched);
         finish(scene, p, decision, sig, &ctx, rec)
     } else {
         finish(scene, p, decision, Steady::<R>::new(a1, p.omega), &ctx, rec)
+    }?;
+    // The end state is reported as the full one: the slow state with its wobble put back, at
+    // the drive's phase and frequency there.
+    if let Some(w) = wobble {
+        let (t, phi, phi_rate) = report.end;
+        let drive = sched.state(t);
+        if drive.omega <= 0.0 {
+            return Ok(report);
+        }
+        let w = Wobble {
+            omega: drive.omega,
+            ..w
+        };
+        let (theta, rate) = w.full((phi, phi_rate), drive.phase);
+        report.end = (t, theta, rate);
     }
+    Ok(report)
 }
 
 /// Runs the composed equation, then classifies (running the Lyapunov pair only if asked).
