@@ -95,12 +95,14 @@ impl Plan {
             ladders: vec![
                 (Rk4, F64, doubling(8.0, 2048.0)),
                 (Dop853, F64, tol.clone()),
+                (Rkn86, F64, tol.clone()),
                 (Verlet, F64, doubling(16.0, 16384.0)),
                 (Yoshida4, F64, doubling(8.0, 2048.0)),
                 (Yoshida6, F64, doubling(4.0, 1024.0)),
                 (AveragedDop853, F64, decades(-3, -12, 3)),
                 (Rk4, F32, doubling(8.0, 512.0)),
                 (Dop853, F32, decades(-3, -7, 1)),
+                (Rkn86, F32, decades(-3, -7, 1)),
                 (Verlet, F32, doubling(16.0, 1024.0)),
                 (Yoshida4, F32, doubling(8.0, 256.0)),
             ],
@@ -142,6 +144,7 @@ impl Plan {
             ladders: vec![
                 (Rk4, F64, vec![16.0, 64.0, 256.0]),
                 (Dop853, F64, tol.clone()),
+                (Rkn86, F64, tol.clone()),
                 (Verlet, F64, vec![64.0, 256.0, 1024.0]),
                 (Yoshida4, F64, vec![16.0, 64.0, 256.0]),
                 (Yoshida6, F64, vec![8.0, 32.0, 128.0]),
@@ -173,12 +176,14 @@ fn physical_ladders(quick: bool) -> Vec<Ladder> {
         vec![
             (Rk4, F64, vec![8.0, 16.0, 32.0]),
             (Dop853, F64, vec![1e-3, 1e-5]),
+            (Rkn86, F64, vec![1e-3, 1e-5]),
             (AveragedDop853, F64, vec![1e-3, 1e-5]),
         ]
     } else {
         vec![
             (Rk4, F64, doubling(4.0, 256.0)),
             (Dop853, F64, decades(-2, -10, 1)),
+            (Rkn86, F64, decades(-2, -10, 1)),
             (Verlet, F64, doubling(8.0, 512.0)),
             (Yoshida4, F64, doubling(4.0, 256.0)),
             (AveragedDop853, F64, decades(-2, -10, 1)),

@@ -194,6 +194,7 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
         .collect();
     let (method, rtol, atol, steps_per_period) = match file.method {
         Method::Dop853 { rtol, atol } => ("dop853", Some(rtol), Some(atol), None),
+        Method::Rkn86 { rtol, atol } => ("rkn86", Some(rtol), Some(atol), None),
         Method::Rk4 { steps_per_period } => ("rk4", None, None, Some(steps_per_period)),
         Method::Symplectic {
             scheme,

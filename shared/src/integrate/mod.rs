@@ -21,6 +21,7 @@ mod rk4;
 pub mod rkn;
 mod symplectic;
 
+pub(crate) use dop853::TOLERANCE_FLOOR;
 pub use dop853::{Dop853, IntegrateError, Step, StepControl};
 pub use fixed::Control;
 pub use rk4::{rk4_fixed, rk4_observe, rk4_step};

@@ -58,16 +58,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     let mut solver = Dop853::new(rtol, atol);
     solver.h_max = 16.0 * ctx.period;
     solver.max_steps = u64::MAX;
-    let mut sampler = Sampler::new(
-        ctx.schedule,
-        ctx.strobes_total,
-        ctx.out_dt,
-        ctx.sensor.clone(),
-        ctx.t_end,
-        ctx.classify,
-        rec,
-    );
-    sampler.start(ctx.y0.0, ctx.y0.1);
+    let mut sampler = ctx.sampler(rec);
     let natural = crate::math::TAU / crate::math::sqrt(eom.omega0_sq.to_f64());
     let check_dt = ctx.period.min(natural) / STICK_CHECKS_PER_PERIOD;
     let held = |t: f64, theta: R| eom.conservative(t, theta).to_f64();

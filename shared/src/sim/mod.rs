@@ -11,6 +11,7 @@
 //! | [`sampling`] | strobes, period means, output and sensor samples between steps |
 //! | [`sensor`] | the pivot encoder: sampled, noisy, quantised |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
+//! | `periodic` | the full equation by RKN 8(6), a whole number of steps per drive period |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
 //! | [`run`] | `simulate`: compose, integrate, sample, classify |
@@ -20,6 +21,7 @@ pub mod eom;
 pub mod fidelity;
 mod friction;
 mod lyapunov;
+mod periodic;
 pub mod run;
 pub mod sampling;
 pub mod scene;

@@ -12,6 +12,7 @@ use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use super::fidelity::{self, Decision, FidelityError};
 use super::friction;
 use super::lyapunov;
+use super::periodic;
 use super::sampling::{Hermite, Interpolant, Recorder, Sampler};
 use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
@@ -32,6 +33,10 @@ pub enum Method {
     Rk4 { steps_per_period: f64 },
     /// Adaptive Dormand–Prince 8(5,3) with dense output.
     Dop853 { rtol: f64, atol: f64 },
+    /// Runge–Kutta–Nyström 8(6) with a whole number of steps per drive period, chosen per
+    /// period from its error estimate ([`super::periodic`]): the full equation with a drive
+    /// periodic from t = 0, and viscous damping or none.
+    Rkn86 { rtol: f64, atol: f64 },
     /// A symplectic method (Störmer–Verlet or a Yoshida composition) with a fixed step of
     /// T/steps_per_period: undamped scenes only.
     Symplectic {
@@ -160,6 +165,23 @@ pub(super) struct Context {
     pub periodic: bool,
 }
 
+impl Context {
+    /// The run's sampler, started at t = 0 from the initial state.
+    pub(super) fn sampler<'r, Rec: Recorder>(&self, rec: &'r mut Rec) -> Sampler<'r, Rec> {
+        let mut sampler = Sampler::new(
+            self.schedule,
+            self.strobes_total,
+            self.out_dt,
+            self.sensor.clone(),
+            self.t_end,
+            self.classify,
+            rec,
+        );
+        sampler.start(self.y0.0, self.y0.1);
+        sampler
+    }
+}
+
 /// The raw result of a generic run, before classification.
 pub(super) struct RunOut<'a, Rec: Recorder> {
     pub sampler: Sampler<'a, Rec>,
@@ -209,18 +231,21 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
                 ));
             }
         }
-        Method::Dop853 { rtol, atol } => {
-            if !(rtol.is_finite()
-                && atol.is_finite()
-                && rtol >= 0.0
-                && atol >= 0.0
-                && rtol + atol > 0.0)
-            {
+        Method::Rkn86 { rtol, atol } => {
+            tolerances(rtol, atol)?;
+            let e = &scene.effects;
+            if e.ramp.is_some() || e.actuator.is_some() {
                 return Err(SimError::Unsupported(
-                    "run.rtol and run.atol must be finite, >= 0, not both 0",
+                    "method rkn86 needs a drive periodic from t = 0: it cannot run effects.ramp or effects.actuator (use dop853)",
+                ));
+            }
+            if e.coulomb.is_some() {
+                return Err(SimError::Unsupported(
+                    "method rkn86 cannot run effects.coulomb: stick–slip needs event location (use dop853)",
                 ));
             }
         }
+        Method::Dop853 { rtol, atol } => tolerances(rtol, atol)?,
     }
     let out_dt = options.out_dt;
     let t_end = scene.duration(p.omega);
@@ -230,6 +255,17 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
         ));
     }
     Ok(())
+}
+
+/// Tolerances of an adaptive method: finite, ≥ 0, not both 0.
+fn tolerances(rtol: f64, atol: f64) -> Result<(), SimError> {
+    if rtol.is_finite() && atol.is_finite() && rtol >= 0.0 && atol >= 0.0 && rtol + atol > 0.0 {
+        Ok(())
+    } else {
+        Err(SimError::Unsupported(
+            "run.rtol and run.atol must be finite, >= 0, not both 0",
+        ))
+    }
 }
 
 /// More steps per drive period than any accuracy needs (RK4's error is at rounding by 10⁴);
@@ -336,13 +372,19 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
     ctx: &Context,
     rec: &mut Rec,
 ) -> Result<Report, SimError> {
-    let out = match scene.effects.coulomb {
-        Some(mu) => {
-            let eom =
-                FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
-            friction::run(eom, R::from_f64(p.c), mu, ctx, rec)?
+    let full =
+        || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
+    let out = match (scene.effects.coulomb, ctx.method) {
+        (Some(mu), _) => friction::run(full(), R::from_f64(p.c), mu, ctx, rec)?,
+        (None, Method::Rkn86 { rtol, atol }) => {
+            if decision.fidelity != Fidelity::Full {
+                return Err(SimError::Unsupported(
+                    "method rkn86 integrates the full equation only: set run.fidelity = \"full\", or use dop853",
+                ));
+            }
+            periodic::run(full(), p.c, (rtol, atol), ctx, rec)?
         }
-        None => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
+        (None, _) => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
     };
     let RunOut {
         sampler,
@@ -478,16 +520,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     ctx: &Context,
     rec: &'r mut Rec,
 ) -> Result<RunOut<'r, Rec>, SimError> {
-    let mut sampler = Sampler::new(
-        ctx.schedule,
-        ctx.strobes_total,
-        ctx.out_dt,
-        ctx.sensor.clone(),
-        ctx.t_end,
-        ctx.classify,
-        rec,
-    );
-    sampler.start(ctx.y0.0, ctx.y0.1);
+    let mut sampler = ctx.sampler(rec);
     let mut turns = Turns::new(ctx.periodic);
     let mut y = [turns.reduce(R::from_f64(ctx.y0.0)), R::from_f64(ctx.y0.1)];
     let mut t = 0.0;
@@ -535,6 +568,11 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             };
             let n_h = fixed_steps(ctx, steps_per_period);
             (t, y) = in_stretches(&driver, &sys, n_h, y, &mut turns, &mut sampler, &mut work);
+        }
+        Method::Rkn86 { .. } => {
+            return Err(SimError::Unsupported(
+                "method rkn86 runs the full equation through its own loop",
+            ))
         }
         Method::Rk4 { steps_per_period } => {
             let n_h = fixed_steps(ctx, steps_per_period);
