@@ -163,6 +163,11 @@ pub(super) struct Context {
     pub classify: bool,
     /// The equation is 2π-periodic in θ (full and averaged), so whole turns may be taken out.
     pub periodic: bool,
+    /// Longest DOP853 step (s). The full and linearised equations, whose drive is inside the
+    /// equation, are held to 16 drive periods so that a step never jumps the drive unseen; the
+    /// averaged equation has no drive term to miss and its strobes and period means come from
+    /// the dense output, so its step is limited by its error estimate alone.
+    pub h_max: f64,
 }
 
 impl Context {
@@ -337,6 +342,11 @@ fn run_format<R: Real, Rec: Recorder>(
         undamped: p.c == 0.0 && scene.effects.coulomb.is_none(),
         classify: options.classify,
         periodic: decision.fidelity != Fidelity::Linearised,
+        h_max: if decision.fidelity == Fidelity::Averaged {
+            f64::INFINITY
+        } else {
+            16.0 * math::TAU / p.omega
+        },
     };
     let a1 = p.amplitude / p.ell;
     let mut report = if shaped(scene) {
@@ -528,9 +538,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     match ctx.method {
         Method::Dop853 { rtol, atol } => {
             let mut solver = Dop853::new(rtol, atol);
-            // A step may not jump over a whole drive period unseen (long runs of the averaged
-            // model would otherwise step past the strobes' resolution of the slow motion).
-            solver.h_max = 16.0 * ctx.period;
+            solver.h_max = ctx.h_max;
             solver.max_steps = u64::MAX;
             loop {
                 let offset = turns.offset();
