@@ -10,7 +10,8 @@
 //!   p = 2, the two points apart (d(k, k−1) > TOL) → flutter
 //!   p ≥ 3, the p points distinct (some d(k, k−1) > 5·TOL) → subharmonic of order p
 //! otherwise:   still contracting → undecided (run longer); finite-time Lyapunov exponent with
-//!   growth e^{λ T_F} > e^5 → chaotic; undamped and bounded → oscillation about its centre
+//!   growth e^{λ T_F} > e^5 → chaotic; undamped and bounded → oscillation: centre and half the
+//!   range of the period means (the middle of the range, not their mean)
 //! ```
 //! TOL = 2e-3 rad (0.11°) is the resolution of the physical question (a resting angle to 0.1°).
 //! F spans many drive periods, so a slow oscillation is seen whole rather than at a turning
@@ -236,15 +237,16 @@ pub fn classify(
         return Outcome::Chaotic { lyapunov: lambda };
     }
     if undamped && !drifting {
-        let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+        // The centre is the middle of the range: the mean over a window that does not hold a
+        // whole number of slow oscillations is biased by the part-cycle at its end.
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for i in 0..n {
             let m = strobes.get(i).mean;
             lo = lo.min(m);
             hi = hi.max(m);
-            sum += m;
         }
         return Outcome::Oscillation {
-            angle: math::wrap_pi(sum / n as f64),
+            angle: math::wrap_pi(0.5 * (lo + hi)),
             amplitude: 0.5 * (hi - lo),
         };
     }
@@ -390,6 +392,30 @@ mod tests {
                 periods: 2
             }
         );
+    }
+
+    #[test]
+    fn oscillation_centre_is_the_middle_of_its_range() {
+        // 2.3 slow cycles of 1 ± 0.3 rad in the window: the centre is 1 and the half-range 0.3
+        // (closed form), up to the sampling of the extremes, 0.3 (1 − cos(π·2.3/1000)) < 1e-5;
+        // the mean of the samples would be off by the part-cycle, 0.3 sin(2π·2.3)/(2π·2.3) ≈ 0.02.
+        let n = 1000;
+        let slow = |k: usize| 1.0 + 0.3 * (math::TAU * 2.3 * k as f64 / n as f64).cos();
+        let s = fill(
+            |k| Strobe {
+                theta: slow(k),
+                rate: 0.0,
+                mean: slow(k),
+            },
+            n,
+        );
+        match classify(&s, W, true, || 0.0) {
+            Outcome::Oscillation { angle, amplitude } => {
+                assert!((angle - 1.0).abs() < 1e-5, "{angle}");
+                assert!((amplitude - 0.3).abs() < 1e-5, "{amplitude}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]
