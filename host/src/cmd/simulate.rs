@@ -280,9 +280,15 @@ fn print_summary(s: &Summary, report: &Report, out: &mut dyn Write) -> Result<()
         "fidelity: {} ({} requested): {}",
         s.fidelity.used, s.fidelity.requested, s.fidelity.reason
     )?;
+    let name = match s.method {
+        "dop853" => "DOP853",
+        "rkn86" => "RKN 8(6)",
+        "rk4" => "RK4",
+        other => other,
+    };
     let method = match (s.rtol, s.atol, s.steps_per_period) {
-        (Some(r), Some(a), _) => format!("DOP853, rtol {r:e}, atol {a:e}"),
-        (_, _, Some(n)) => format!("RK4, {n} steps per drive period"),
+        (Some(r), Some(a), _) => format!("{name}, rtol {r:e}, atol {a:e}"),
+        (_, _, Some(n)) => format!("{name}, {n} steps per drive period"),
         _ => s.method.to_string(),
     };
     writeln!(out, "method: {method}; numbers: {}", s.format)?;
