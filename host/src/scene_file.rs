@@ -232,6 +232,7 @@ enum MethodName {
     #[default]
     Auto,
     Dop853,
+    Rkn86,
     Rk4,
     Verlet,
     Yoshida4,
@@ -425,7 +426,7 @@ fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     fidelity::decide(&scene, &p).map_err(|e| anyhow!("{e}"))?;
     let method = method(run)?;
     if !matches!(method, Method::Dop853 { .. }) && scene.effects.coulomb.is_some() {
-        bail!("run.method: a fixed-step method cannot run effects.coulomb: allowed \"dop853\" or \"auto\" (stick–slip needs event location)");
+        bail!("run.method: only dop853 can run effects.coulomb: allowed \"dop853\" or \"auto\" (stick–slip needs event location)");
     }
     if matches!(method, Method::Symplectic { .. }) && p.c > 0.0 {
         bail!("run.method: symplectic methods integrate undamped motion only: remove effects.viscous, or use \"dop853\" or \"rk4\"");
@@ -550,7 +551,7 @@ fn method(run: &RawRun) -> Result<Method> {
     let fixed_step = |name: &str| -> Result<f64> {
         for (key, v) in [("rtol", run.rtol), ("atol", run.atol)] {
             if let Some(v) = v {
-                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\")");
+                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\" and \"rkn86\")");
             }
         }
         run.steps_per_period.map_or(Ok(DEFAULT_RK4_STEPS), |s| {
@@ -570,7 +571,7 @@ fn method(run: &RawRun) -> Result<Method> {
         MethodName::Verlet => symplectic(Symplectic::Verlet, "verlet"),
         MethodName::Yoshida4 => symplectic(Symplectic::Yoshida4, "yoshida4"),
         MethodName::Yoshida6 => symplectic(Symplectic::Yoshida6, "yoshida6"),
-        MethodName::Auto | MethodName::Dop853 => {
+        MethodName::Auto | MethodName::Dop853 | MethodName::Rkn86 => {
             if let Some(s) = run.steps_per_period {
                 bail!("run.steps_per_period = {s} is not allowed with an adaptive method: allowed only with a fixed-step method (rk4, verlet, yoshida4, yoshida6)");
             }
@@ -579,7 +580,10 @@ fn method(run: &RawRun) -> Result<Method> {
             };
             let rtol = run.rtol.map_or(Ok(rtol), |v| positive("run.rtol", v))?;
             let atol = run.atol.map_or(Ok(atol), |v| positive("run.atol", v))?;
-            Ok(Method::Dop853 { rtol, atol })
+            Ok(match run.method {
+                MethodName::Rkn86 => Method::Rkn86 { rtol, atol },
+                _ => Method::Dop853 { rtol, atol },
+            })
         }
     }
 }

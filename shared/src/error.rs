@@ -18,8 +18,26 @@ impl fmt::Display for ParamError {
         write!(
             f,
             "{} = {} is out of range: allowed {}",
-            self.name, self.value, self.allowed
+            self.name,
+            Compact(self.value),
+            self.allowed
         )
+    }
+}
+
+/// A number as an error message shows it: plainly at ordinary magnitudes, in exponent form
+/// beyond them, so that 1e300 reads as `1e300` and not as 301 digits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Compact(pub f64);
+
+impl fmt::Display for Compact {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = self.0.abs();
+        if a.is_finite() && a != 0.0 && !(1e-6..1e15).contains(&a) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
     }
 }
 
@@ -68,6 +86,15 @@ pub fn finite(name: &'static str, value: f64) -> Result<f64, ParamError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_and_tiny_numbers_are_shown_in_exponent_form() {
+        assert_eq!(format!("{}", Compact(1e300)), "1e300");
+        assert_eq!(format!("{}", Compact(-2.5e-9)), "-2.5e-9");
+        assert_eq!(format!("{}", Compact(330.0)), "330");
+        assert_eq!(format!("{}", Compact(0.0)), "0");
+        assert_eq!(format!("{}", Compact(f64::INFINITY)), "inf");
+    }
 
     #[test]
     fn rejects_nan_inf_and_sign() {

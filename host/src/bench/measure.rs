@@ -34,6 +34,8 @@ pub enum Family {
     Rk4,
     /// Our DOP853; setting: rtol = atol.
     Dop853,
+    /// Our RKN 8(6), a whole number of steps per drive period; setting: rtol = atol.
+    Rkn86,
     /// Störmer–Verlet; setting: steps per drive period.
     Verlet,
     /// Yoshida's 4th-order composition; setting: steps per drive period.
@@ -55,6 +57,7 @@ impl Family {
         match self {
             Family::Rk4 => "rk4",
             Family::Dop853 => "dop853",
+            Family::Rkn86 => "rkn86",
             Family::Verlet => "verlet",
             Family::Yoshida4 => "yoshida4",
             Family::Yoshida6 => "yoshida6",
@@ -70,6 +73,7 @@ impl Family {
         match self {
             Family::Rk4 => "RK4",
             Family::Dop853 => "DOP853",
+            Family::Rkn86 => "RKN 8(6)",
             Family::Verlet => "Verlet",
             Family::Yoshida4 => "Yoshida 4",
             Family::Yoshida6 => "Yoshida 6",
@@ -96,6 +100,7 @@ impl Family {
         matches!(
             self,
             Family::Dop853
+                | Family::Rkn86
                 | Family::AveragedDop853
                 | Family::PeerDopri5
                 | Family::PeerDop853
@@ -131,6 +136,10 @@ impl Family {
                 steps_per_period: setting,
             },
             Family::Dop853 | Family::AveragedDop853 => Method::Dop853 {
+                rtol: setting,
+                atol: setting,
+            },
+            Family::Rkn86 => Method::Rkn86 {
                 rtol: setting,
                 atol: setting,
             },

@@ -11,6 +11,7 @@
 //! | [`ratio`] | cost at a matched error (log-log interpolation) and ours over the peer's |
 //! | [`ladder`] | the stability criteria against Floquet, and Floquet's own convergence |
 //! | [`physical`] | the cheapest right answer per scene, `auto`, and the averaged model's validity |
+//! | [`realtime`] | real-time factors at a final error of 1e-6, full and averaged model |
 //! | [`report`] | the results as JSON, CSV and Markdown |
 //! | [`plots`] | log-log PNGs |
 
@@ -21,6 +22,7 @@ pub mod peer;
 pub mod physical;
 pub mod plots;
 pub mod ratio;
+pub mod realtime;
 pub mod report;
 pub mod scenes;
 
@@ -95,12 +97,14 @@ impl Plan {
             ladders: vec![
                 (Rk4, F64, doubling(8.0, 2048.0)),
                 (Dop853, F64, tol.clone()),
+                (Rkn86, F64, tol.clone()),
                 (Verlet, F64, doubling(16.0, 16384.0)),
                 (Yoshida4, F64, doubling(8.0, 2048.0)),
                 (Yoshida6, F64, doubling(4.0, 1024.0)),
                 (AveragedDop853, F64, decades(-3, -12, 3)),
                 (Rk4, F32, doubling(8.0, 512.0)),
                 (Dop853, F32, decades(-3, -7, 1)),
+                (Rkn86, F32, decades(-3, -7, 1)),
                 (Verlet, F32, doubling(16.0, 1024.0)),
                 (Yoshida4, F32, doubling(8.0, 256.0)),
             ],
@@ -142,6 +146,7 @@ impl Plan {
             ladders: vec![
                 (Rk4, F64, vec![16.0, 64.0, 256.0]),
                 (Dop853, F64, tol.clone()),
+                (Rkn86, F64, tol.clone()),
                 (Verlet, F64, vec![64.0, 256.0, 1024.0]),
                 (Yoshida4, F64, vec![16.0, 64.0, 256.0]),
                 (Yoshida6, F64, vec![8.0, 32.0, 128.0]),
@@ -173,12 +178,14 @@ fn physical_ladders(quick: bool) -> Vec<Ladder> {
         vec![
             (Rk4, F64, vec![8.0, 16.0, 32.0]),
             (Dop853, F64, vec![1e-3, 1e-5]),
+            (Rkn86, F64, vec![1e-3, 1e-5]),
             (AveragedDop853, F64, vec![1e-3, 1e-5]),
         ]
     } else {
         vec![
             (Rk4, F64, doubling(4.0, 256.0)),
             (Dop853, F64, decades(-2, -10, 1)),
+            (Rkn86, F64, decades(-2, -10, 1)),
             (Verlet, F64, doubling(8.0, 512.0)),
             (Yoshida4, F64, doubling(4.0, 256.0)),
             (AveragedDop853, F64, decades(-2, -10, 1)),
@@ -236,6 +243,8 @@ pub struct Results {
     pub averaged_thresholds: Vec<physical::Threshold>,
     /// The shipped chaotic scene's verdict at each tolerance.
     pub chaotic_fate: Vec<physical::FateRow>,
+    /// Simulated seconds per CPU second at a final error of 1e-6 (see [`realtime`]).
+    pub real_time_factors: Vec<realtime::RealTimeFactor>,
     /// Settings left out (over the evaluation budget) or that failed, with why.
     pub skipped: Vec<String>,
     pub notes: Vec<String>,
@@ -377,7 +386,8 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
         + plan.ladder.floquet_ks.len() * plan.ladder.floquet_steps.len()
         + physical_ticks
         + 2 * plan.calibration_ratios.len()
-        + plan.fate_tolerances.len();
+        + plan.fate_tolerances.len()
+        + 3;
     progress.set_total(total as u64);
 
     let mut references = Vec::new();
@@ -496,6 +506,8 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
             lyapunov,
         });
     }
+    let real_time_factors =
+        realtime::real_time_factors(plan.batch, || progress.tick("real-time factors"))?;
     machine.load_end = load_average();
     Ok(Results {
         quick: plan.quick,
@@ -510,6 +522,7 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
         averaged_thresholds: physical::thresholds(&averaged_validity),
         averaged_validity,
         chaotic_fate,
+        real_time_factors,
         skipped,
         notes,
         wall_s: started.elapsed().as_secs_f64(),

@@ -30,6 +30,7 @@ fn colour(f: Family) -> RGBColor {
     match f {
         Family::Rk4 => RGBColor(31, 119, 180),
         Family::Dop853 => RGBColor(214, 39, 40),
+        Family::Rkn86 => RGBColor(23, 190, 207),
         Family::Verlet => RGBColor(44, 160, 44),
         Family::Yoshida4 => RGBColor(148, 103, 189),
         Family::Yoshida6 => RGBColor(140, 86, 75),

@@ -5,7 +5,9 @@ use serde::Serialize;
 use std::io::Write;
 
 use crate::input::{self, GeometryArgs};
+use kapitza_core::error::Compact;
 use kapitza_core::math;
+use kapitza_core::model::drive::{ANGLE_RANGE, MAX_ANGLE_DEG};
 use kapitza_core::model::equilibria::saddle_node_r;
 use kapitza_core::model::{equilibria, DriveAngle, Equilibrium, Groups, Stability};
 
@@ -122,6 +124,12 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
 
 pub fn compute(args: &Args) -> Result<Report> {
     let angle_deg = input::finite("--angle", args.angle)?;
+    if angle_deg.abs() > MAX_ANGLE_DEG {
+        bail!(
+            "--angle {} is out of range: expected {ANGLE_RANGE}",
+            Compact(angle_deg)
+        );
+    }
     let theta_d = DriveAngle::from_deg(angle_deg)?;
     let gravity = input::positive("--gravity", args.gravity)?;
     let (r, physical) = match (args.r, args.geometry.geometry()?) {

@@ -41,7 +41,7 @@ pub struct Args {
     pub check: bool,
     /// Time-series samples per drive period for series.csv and the plots (at most 200 000
     /// samples in all: long runs are sampled more sparsely).
-    #[arg(long, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", default_value_t = 20, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub samples_per_period: u32,
 }
 
@@ -194,6 +194,7 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
         .collect();
     let (method, rtol, atol, steps_per_period) = match file.method {
         Method::Dop853 { rtol, atol } => ("dop853", Some(rtol), Some(atol), None),
+        Method::Rkn86 { rtol, atol } => ("rkn86", Some(rtol), Some(atol), None),
         Method::Rk4 { steps_per_period } => ("rk4", None, None, Some(steps_per_period)),
         Method::Symplectic {
             scheme,
@@ -279,9 +280,15 @@ fn print_summary(s: &Summary, report: &Report, out: &mut dyn Write) -> Result<()
         "fidelity: {} ({} requested): {}",
         s.fidelity.used, s.fidelity.requested, s.fidelity.reason
     )?;
+    let name = match s.method {
+        "dop853" => "DOP853",
+        "rkn86" => "RKN 8(6)",
+        "rk4" => "RK4",
+        other => other,
+    };
     let method = match (s.rtol, s.atol, s.steps_per_period) {
-        (Some(r), Some(a), _) => format!("DOP853, rtol {r:e}, atol {a:e}"),
-        (_, _, Some(n)) => format!("RK4, {n} steps per drive period"),
+        (Some(r), Some(a), _) => format!("{name}, rtol {r:e}, atol {a:e}"),
+        (_, _, Some(n)) => format!("{name}, {n} steps per drive period"),
         _ => s.method.to_string(),
     };
     writeln!(out, "method: {method}; numbers: {}", s.format)?;

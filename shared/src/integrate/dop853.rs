@@ -311,7 +311,7 @@ impl Dop853 {
 }
 
 /// The tolerances in force are at least this many ε of the number format (see # Precision).
-const TOLERANCE_FLOOR: f64 = 100.0;
+pub(crate) const TOLERANCE_FLOOR: f64 = 100.0;
 
 #[derive(Debug, Clone, Copy)]
 struct Tolerance {

@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | [`rk4_fixed`], [`rk4_observe`] | classical Runge–Kutta, fixed step | 4 | 4 f-evaluations |
 //! | [`Dop853`] | Dormand–Prince 8(5,3), adaptive, 7th-order dense output | 8 | 12 (+3 when the dense output is used) |
+//! | [`DampedRkn`] | Runge–Kutta–Nyström 8(6) (Dormand, El-Mikkawy & Prince) for θ'' = g(t, θ) − c θ', damping by a change of variable | 8 (6 embedded) | 8 g-evaluations (FSAL) |
 //! | [`symplectic_fixed`] with [`Symplectic::Verlet`] | Störmer–Verlet (kick–drift–kick) | 2 | 1 force evaluation |
 //! | … with [`Symplectic::Yoshida4`] / [`Symplectic::Yoshida6`] | symmetric compositions of Verlet | 4 / 6 | 3 / 7 |
 //!
@@ -17,11 +18,14 @@
 mod dop853;
 mod fixed;
 mod rk4;
+pub mod rkn;
 mod symplectic;
 
+pub(crate) use dop853::TOLERANCE_FLOOR;
 pub use dop853::{Dop853, IntegrateError, Step, StepControl};
 pub use fixed::Control;
 pub use rk4::{rk4_fixed, rk4_observe, rk4_step};
+pub use rkn::{DampedRkn, RknStep};
 pub use symplectic::{symplectic_fixed, Force, Phase, Symplectic};
 
 use crate::Real;

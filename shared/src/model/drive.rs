@@ -14,9 +14,24 @@ pub struct DriveAngle {
     cos: f64,
 }
 
+/// Largest angle accepted in degrees, either way. An angle is meant modulo a turn; one given as
+/// 1e17° has an f64 spacing of 16°, so whatever it was meant to be is already lost. At 1e6° the
+/// spacing is 1.2e-10°, far below any resolution the project uses.
+pub const MAX_ANGLE_DEG: f64 = 1e6;
+/// [`MAX_ANGLE_DEG`] as the allowed range of an error message.
+pub const ANGLE_RANGE: &str = "a number in [-1e6, 1e6] degrees";
+
 impl DriveAngle {
+    /// θd from degrees in [−[`MAX_ANGLE_DEG`], [`MAX_ANGLE_DEG`]].
     pub fn from_deg(deg: f64) -> Result<Self, ParamError> {
         let deg = finite("drive angle", deg)?;
+        if deg.abs() > MAX_ANGLE_DEG {
+            return Err(ParamError {
+                name: "drive angle",
+                value: deg,
+                allowed: ANGLE_RANGE,
+            });
+        }
         let (sin, cos) = math::sin_cos_deg(deg);
         Ok(Self {
             rad: math::wrap_pi(math::to_rad(deg)),

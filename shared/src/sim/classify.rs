@@ -4,17 +4,26 @@
 //! strobe k: (θ_k, θ'_k) at drive phase 2πk, and m_k = the mean of θ over the period ending there
 //! F: the final half of the analysis window (≥ 32 strobes)
 //! rest:        over F, range of θ_k ≤ TOL and range of θ'_k/ω ≤ TOL; angle = mean of the m_k
-//! period p:    over F, |wrap(θ_k − θ_{k−p})| ≤ TOL and |θ'_k − θ'_{k−p}|/ω ≤ TOL
+//! d(j, k):     max(|wrap(θ_j − θ_k)|, |θ'_j − θ'_k|/ω), the distance of two strobed states
+//! period p:    over F, d(k, k−p) ≤ TOL
 //!   turning (θ_k − θ_{k−p} = 2πq, q ≠ 0) → rotation (sign of q)
-//!   else, with the p points of the orbit distinct (some |θ_k − θ_{k−1}| > 5·TOL):
-//!   p = 2 → flutter;  p ≥ 3 → subharmonic of order p
+//!   p = 2, the two points apart (d(k, k−1) > TOL) → flutter
+//!   p ≥ 3, the p points distinct (some d(k, k−1) > 5·TOL) → subharmonic of order p
 //! otherwise:   still contracting → undecided (run longer); finite-time Lyapunov exponent with
-//!   growth e^{λ T_F} > e^5 → chaotic; undamped and bounded → oscillation about its centre
+//!   growth e^{λ T_F} > e^5 → chaotic; undamped and bounded → oscillation: centre and half the
+//!   range of the period means (the middle of the range, not their mean)
 //! ```
 //! TOL = 2e-3 rad (0.11°) is the resolution of the physical question (a resting angle to 0.1°).
 //! F spans many drive periods, so a slow oscillation is seen whole rather than at a turning
 //! point; the distinct-points rule keeps a decaying slow oscillation whose period is close to p
 //! drive periods from passing for a subharmonic.
+//!
+//! Distances are taken on the whole strobed state, not on θ alone: with a purely sinusoidal
+//! drive, θd and θd + 180° are the same shaking line half a drive period apart, so the same
+//! period-2 orbit is strobed at the other half of its cycle, where its two points may share
+//! their angle and differ only in rate. Flutter's threshold is the rest threshold TOL: a period-2
+//! motion that is not rest is flutter, however small, so a run at the flutter onset cannot fall
+//! between the two verdicts.
 //! The classifier judges the true state, never the sensor's view of it.
 
 use crate::math;
@@ -192,9 +201,9 @@ pub fn classify(
                 periods: p as u32,
             };
         }
-        let distinct = (0..p).any(|i| {
-            math::wrap_pi(strobes.last(i).theta - strobes.last(i + 1).theta).abs() > 5.0 * TOL
-        });
+        let threshold = if p == 2 { TOL } else { 5.0 * TOL };
+        let distinct =
+            (0..p).any(|i| distance(strobes.last(i), strobes.last(i + 1), omega) > threshold);
         if p >= 2 && distinct {
             return match p {
                 2 => Outcome::Flutter { angle: centre(2) },
@@ -228,15 +237,16 @@ pub fn classify(
         return Outcome::Chaotic { lyapunov: lambda };
     }
     if undamped && !drifting {
-        let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+        // The centre is the middle of the range: the mean over a window that does not hold a
+        // whole number of slow oscillations is biased by the part-cycle at its end.
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for i in 0..n {
             let m = strobes.get(i).mean;
             lo = lo.min(m);
             hi = hi.max(m);
-            sum += m;
         }
         return Outcome::Oscillation {
-            angle: math::wrap_pi(sum / n as f64),
+            angle: math::wrap_pi(0.5 * (lo + hi)),
             amplitude: 0.5 * (hi - lo),
         };
     }
@@ -250,10 +260,14 @@ fn periodic(strobes: &Strobes, p: usize, span: usize, omega: f64) -> bool {
     if span <= p {
         return false;
     }
-    (0..span - p).all(|back| {
-        let (a, b) = (strobes.last(back), strobes.last(back + p));
-        math::wrap_pi(a.theta - b.theta).abs() <= TOL && (a.rate - b.rate).abs() / omega <= TOL
-    })
+    (0..span - p).all(|back| distance(strobes.last(back), strobes.last(back + p), omega) <= TOL)
+}
+
+/// max(|wrap(Δθ)|, |Δθ'|/ω): how far apart two strobed states are.
+fn distance(a: Strobe, b: Strobe, omega: f64) -> f64 {
+    math::wrap_pi(a.theta - b.theta)
+        .abs()
+        .max((a.rate - b.rate).abs() / omega)
 }
 
 #[cfg(test)]
@@ -378,6 +392,77 @@ mod tests {
                 periods: 2
             }
         );
+    }
+
+    #[test]
+    fn oscillation_centre_is_the_middle_of_its_range() {
+        // 2.3 slow cycles of 1 ± 0.3 rad in the window: the centre is 1 and the half-range 0.3
+        // (closed form), up to the sampling of the extremes, 0.3 (1 − cos(π·2.3/1000)) < 1e-5;
+        // the mean of the samples would be off by the part-cycle, 0.3 sin(2π·2.3)/(2π·2.3) ≈ 0.02.
+        let n = 1000;
+        let slow = |k: usize| 1.0 + 0.3 * (math::TAU * 2.3 * k as f64 / n as f64).cos();
+        let s = fill(
+            |k| Strobe {
+                theta: slow(k),
+                rate: 0.0,
+                mean: slow(k),
+            },
+            n,
+        );
+        match classify(&s, W, true, || 0.0) {
+            Outcome::Oscillation { angle, amplitude } => {
+                assert!((angle - 1.0).abs() < 1e-5, "{angle}");
+                assert!((amplitude - 0.3).abs() < 1e-5, "{amplitude}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn flutter_seen_in_either_phase() {
+        // The flutter scene's orbit strobed half a drive period later (θd = 0 instead of 180°,
+        // `kapitza simulate scenes/flutter.toml --set drive.angle_deg=0 --out DIR`, strobes.csv):
+        // its two points differ by 2.5e-3 rad in angle but by 78 rad/s in rate (0.26 at ω = 300);
+        // the centre (the mean of the period means, here 3.0) is placed away from ±π.
+        let w = 300.0;
+        let shifted = fill(
+            |k| {
+                let s = (-1f64).powi(k as i32);
+                Strobe {
+                    theta: 3.0 + 1.26e-3 * s,
+                    rate: 39.19 * s,
+                    mean: 3.0 - 0.227 * s,
+                }
+            },
+            200,
+        );
+        match classify(&shifted, w, false, no_lyapunov) {
+            Outcome::Flutter { angle } => assert!((angle - 3.0).abs() < 1e-12, "{angle}"),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn no_gap_between_rest_and_flutter() {
+        // Period-2 strobes whose spread grows through the rest tolerance: every one is rest
+        // (spread ≤ TOL) or flutter (spread > TOL), never undecided.
+        for spread in [0.5, 0.99, 1.01, 1.5, 3.0, 4.9, 5.1, 10.0].map(|f| f * TOL) {
+            let s = fill(
+                |k| Strobe {
+                    theta: 3.0 + 0.5 * spread * (-1f64).powi(k as i32),
+                    rate: 0.0,
+                    mean: 3.0,
+                },
+                200,
+            );
+            let got = classify(&s, W, false, no_lyapunov);
+            let want_rest = spread <= TOL;
+            assert!(
+                matches!(got, Outcome::Rest { .. }) == want_rest
+                    && matches!(got, Outcome::Flutter { .. }) != want_rest,
+                "spread {spread}: {got:?}"
+            );
+        }
     }
 
     #[test]

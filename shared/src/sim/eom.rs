@@ -102,9 +102,15 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> FullEom<R, D, X> {
     /// carriage (what static friction must hold).
     #[inline(always)]
     pub fn conservative(&self, t: f64, theta: R) -> R {
+        self.conservative_with(self.drive.accel(t), theta)
+    }
+
+    /// [`FullEom::conservative`] with the drive's s̈/ℓ given (from a table, say).
+    #[inline(always)]
+    pub fn conservative_with(&self, accel: R, theta: R) -> R {
         let (s, c) = theta.sin_cos();
         let s_rel = s * self.cos_d - c * self.sin_d;
-        -self.omega0_sq * s + self.drive.accel(t) * s_rel
+        -self.omega0_sq * s + accel * s_rel
     }
 }
 

@@ -6,11 +6,13 @@
 //! | [`signal`] | the drive: pivot acceleration and phase, with ramp, motor lag, slider-crank |
 //! | [`eom`] | full, averaged and linearised equations, composed from the listed effects |
 //! | [`fidelity`] | which equation a scene runs (`auto`: the cheapest valid one) and why |
+//! | [`wobble`] | the fast wobble: full state to the averaged model's slow state and back |
 //! | [`classify`] | the outcome from stroboscopic samples |
 //! | [`sampling`] | strobes, period means, output and sensor samples between steps |
 //! | [`sensor`] | the pivot encoder: sampled, noisy, quantised |
 //! | [`noise`] | seeded, reproducible uniform and Gaussian noise |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
+//! | `periodic` | the full equation by RKN 8(6), a whole number of steps per drive period |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
 //! | [`run`] | `simulate`: compose, integrate, sample, classify |
@@ -21,12 +23,14 @@ pub mod fidelity;
 mod friction;
 mod lyapunov;
 pub mod noise;
+mod periodic;
 pub mod run;
 pub mod sampling;
 pub mod scene;
 pub mod sensor;
 pub mod signal;
 mod turns;
+pub mod wobble;
 
 pub use classify::Outcome;
 pub use run::{simulate, Format, Method, Options, Report, SimError};

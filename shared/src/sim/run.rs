@@ -12,11 +12,13 @@ use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use super::fidelity::{self, Decision, FidelityError};
 use super::friction;
 use super::lyapunov;
+use super::periodic;
 use super::sampling::{Hermite, Interpolant, Recorder, Sampler};
 use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
 use super::turns::{Shifted, Turns};
+use super::wobble::Wobble;
 use crate::integrate::{
     rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
     StepControl, Symplectic, System,
@@ -31,6 +33,10 @@ pub enum Method {
     Rk4 { steps_per_period: f64 },
     /// Adaptive Dormand–Prince 8(5,3) with dense output.
     Dop853 { rtol: f64, atol: f64 },
+    /// Runge–Kutta–Nyström 8(6) with a whole number of steps per drive period, chosen per
+    /// period from its error estimate ([`super::periodic`]): the full equation with a drive
+    /// periodic from t = 0, and viscous damping or none.
+    Rkn86 { rtol: f64, atol: f64 },
     /// A symplectic method (Störmer–Verlet or a Yoshida composition) with a fixed step of
     /// T/steps_per_period: undamped scenes only.
     Symplectic {
@@ -94,7 +100,8 @@ pub struct Report {
     pub work: Stats,
     /// Work of the Lyapunov run, when the classifier needed one.
     pub lyapunov_work: Stats,
-    /// Final time, angle (rad, unwrapped) and rate (rad/s).
+    /// Final time, angle (rad, unwrapped) and rate (rad/s). From the averaged model: the full
+    /// state read back from the slow one ([`super::wobble`]).
     pub end: (f64, f64, f64),
     /// With Coulomb friction: how many times the pendulum stuck.
     pub sticks: Option<u64>,
@@ -156,6 +163,28 @@ pub(super) struct Context {
     pub classify: bool,
     /// The equation is 2π-periodic in θ (full and averaged), so whole turns may be taken out.
     pub periodic: bool,
+    /// Longest DOP853 step (s). The full and linearised equations, whose drive is inside the
+    /// equation, are held to 16 drive periods so that a step never jumps the drive unseen; the
+    /// averaged equation has no drive term to miss and its strobes and period means come from
+    /// the dense output, so its step is limited by its error estimate alone.
+    pub h_max: f64,
+}
+
+impl Context {
+    /// The run's sampler, started at t = 0 from the initial state.
+    pub(super) fn sampler<'r, Rec: Recorder>(&self, rec: &'r mut Rec) -> Sampler<'r, Rec> {
+        let mut sampler = Sampler::new(
+            self.schedule,
+            self.strobes_total,
+            self.out_dt,
+            self.sensor.clone(),
+            self.t_end,
+            self.classify,
+            rec,
+        );
+        sampler.start(self.y0.0, self.y0.1);
+        sampler
+    }
 }
 
 /// The raw result of a generic run, before classification.
@@ -207,18 +236,21 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
                 ));
             }
         }
-        Method::Dop853 { rtol, atol } => {
-            if !(rtol.is_finite()
-                && atol.is_finite()
-                && rtol >= 0.0
-                && atol >= 0.0
-                && rtol + atol > 0.0)
-            {
+        Method::Rkn86 { rtol, atol } => {
+            tolerances(rtol, atol)?;
+            let e = &scene.effects;
+            if e.ramp.is_some() || e.actuator.is_some() {
                 return Err(SimError::Unsupported(
-                    "run.rtol and run.atol must be finite, >= 0, not both 0",
+                    "method rkn86 needs a drive periodic from t = 0: it cannot run effects.ramp or effects.actuator (use dop853)",
+                ));
+            }
+            if e.coulomb.is_some() {
+                return Err(SimError::Unsupported(
+                    "method rkn86 cannot run effects.coulomb: stick–slip needs event location (use dop853)",
                 ));
             }
         }
+        Method::Dop853 { rtol, atol } => tolerances(rtol, atol)?,
     }
     let out_dt = options.out_dt;
     let t_end = scene.duration(p.omega);
@@ -228,6 +260,17 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
         ));
     }
     Ok(())
+}
+
+/// Tolerances of an adaptive method: finite, ≥ 0, not both 0.
+fn tolerances(rtol: f64, atol: f64) -> Result<(), SimError> {
+    if rtol.is_finite() && atol.is_finite() && rtol >= 0.0 && atol >= 0.0 && rtol + atol > 0.0 {
+        Ok(())
+    } else {
+        Err(SimError::Unsupported(
+            "run.rtol and run.atol must be finite, >= 0, not both 0",
+        ))
+    }
 }
 
 /// More steps per drive period than any accuracy needs (RK4's error is at rounding by 10⁴);
@@ -270,9 +313,25 @@ fn run_format<R: Real, Rec: Recorder>(
     let t_end = scene.duration(p.omega);
     // `periods = 4000` must give 4000 strobes, not 3999 through rounding of ω·t_end/2π.
     let strobes_total = libm::floor(sched.state(t_end).phase / math::TAU + 1e-9) as u64;
+    let wobble = (decision.fidelity == Fidelity::Averaged).then(|| Wobble {
+        a1: p.amplitude / p.ell,
+        a2: second_harmonic(scene, p),
+        omega: p.omega,
+        c: p.c,
+        angle: scene.drive.angle,
+    });
+    let given = (scene.initial_angle, scene.initial_rate);
+    // The averaged model starts from the slow state under the given full one. A ramped or
+    // lagging drive starts at rest, with no wobble to take out.
+    let y0 = match wobble {
+        Some(w) if scene.effects.ramp.is_none() && scene.effects.actuator.is_none() => {
+            w.slow(given, 0.0)
+        }
+        _ => given,
+    };
     let ctx = Context {
         method: options.method,
-        y0: (scene.initial_angle, scene.initial_rate),
+        y0,
         t_end,
         schedule: sched,
         strobes_total,
@@ -283,14 +342,35 @@ fn run_format<R: Real, Rec: Recorder>(
         undamped: p.c == 0.0 && scene.effects.coulomb.is_none(),
         classify: options.classify,
         periodic: decision.fidelity != Fidelity::Linearised,
+        h_max: if decision.fidelity == Fidelity::Averaged {
+            f64::INFINITY
+        } else {
+            16.0 * math::TAU / p.omega
+        },
     };
     let a1 = p.amplitude / p.ell;
-    if shaped(scene) {
+    let mut report = if shaped(scene) {
         let sig = Shaped::<R>::new(a1, second_harmonic(scene, p), sched);
         finish(scene, p, decision, sig, &ctx, rec)
     } else {
         finish(scene, p, decision, Steady::<R>::new(a1, p.omega), &ctx, rec)
+    }?;
+    // The end state is reported as the full one: the slow state with its wobble put back, at
+    // the drive's phase and frequency there.
+    if let Some(w) = wobble {
+        let (t, phi, phi_rate) = report.end;
+        let drive = sched.state(t);
+        if drive.omega <= 0.0 {
+            return Ok(report);
+        }
+        let w = Wobble {
+            omega: drive.omega,
+            ..w
+        };
+        let (theta, rate) = w.full((phi, phi_rate), drive.phase);
+        report.end = (t, theta, rate);
     }
+    Ok(report)
 }
 
 /// Runs the composed equation, then classifies (running the Lyapunov pair only if asked).
@@ -302,13 +382,19 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
     ctx: &Context,
     rec: &mut Rec,
 ) -> Result<Report, SimError> {
-    let out = match scene.effects.coulomb {
-        Some(mu) => {
-            let eom =
-                FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
-            friction::run(eom, R::from_f64(p.c), mu, ctx, rec)?
+    let full =
+        || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
+    let out = match (scene.effects.coulomb, ctx.method) {
+        (Some(mu), _) => friction::run(full(), R::from_f64(p.c), mu, ctx, rec)?,
+        (None, Method::Rkn86 { rtol, atol }) => {
+            if decision.fidelity != Fidelity::Full {
+                return Err(SimError::Unsupported(
+                    "method rkn86 integrates the full equation only: set run.fidelity = \"full\", or use dop853",
+                ));
+            }
+            periodic::run(full(), p.c, (rtol, atol), ctx, rec)?
         }
-        None => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
+        (None, _) => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
     };
     let RunOut {
         sampler,
@@ -444,16 +530,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     ctx: &Context,
     rec: &'r mut Rec,
 ) -> Result<RunOut<'r, Rec>, SimError> {
-    let mut sampler = Sampler::new(
-        ctx.schedule,
-        ctx.strobes_total,
-        ctx.out_dt,
-        ctx.sensor.clone(),
-        ctx.t_end,
-        ctx.classify,
-        rec,
-    );
-    sampler.start(ctx.y0.0, ctx.y0.1);
+    let mut sampler = ctx.sampler(rec);
     let mut turns = Turns::new(ctx.periodic);
     let mut y = [turns.reduce(R::from_f64(ctx.y0.0)), R::from_f64(ctx.y0.1)];
     let mut t = 0.0;
@@ -461,9 +538,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     match ctx.method {
         Method::Dop853 { rtol, atol } => {
             let mut solver = Dop853::new(rtol, atol);
-            // A step may not jump over a whole drive period unseen (long runs of the averaged
-            // model would otherwise step past the strobes' resolution of the slow motion).
-            solver.h_max = 16.0 * ctx.period;
+            solver.h_max = ctx.h_max;
             solver.max_steps = u64::MAX;
             loop {
                 let offset = turns.offset();
@@ -501,6 +576,11 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             };
             let n_h = fixed_steps(ctx, steps_per_period);
             (t, y) = in_stretches(&driver, &sys, n_h, y, &mut turns, &mut sampler, &mut work);
+        }
+        Method::Rkn86 { .. } => {
+            return Err(SimError::Unsupported(
+                "method rkn86 runs the full equation through its own loop",
+            ))
         }
         Method::Rk4 { steps_per_period } => {
             let n_h = fixed_steps(ctx, steps_per_period);

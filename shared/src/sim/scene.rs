@@ -109,7 +109,9 @@ impl fmt::Display for SceneError {
         write!(
             f,
             "{} = {} is out of range: allowed {}",
-            self.key, self.value, self.allowed
+            self.key,
+            crate::error::Compact(self.value),
+            self.allowed
         )
     }
 }
@@ -135,7 +137,7 @@ fn check(key: &'static str, value: f64, ok: bool, allowed: &'static str) -> Resu
 /// sets the number of steps.
 pub const MAX_PERIODS: f64 = 1e9;
 
-/// Fastest drive accepted (rad/s). The sampler takes instants within 1e-12 s of a step's end as
+/// Fastest drive accepted (rad/s), and fastest initial rate of turning. The sampler takes instants within 1e-12 s of a step's end as
 /// that end, so a drive period must stay far above it; 1e6 rad/s (6.3 µs) is 6e6 times it, and
 /// 2400 times the rig's limit.
 pub const MAX_OMEGA: f64 = 1e6;
@@ -163,9 +165,12 @@ impl Scene {
             "a finite number > 0 (m)",
         )?;
         match d.frequency {
-            DriveFrequency::Omega(w) => {
-                check("drive.omega", w, w > 0.0, "a finite number > 0 (rad/s)")?
-            }
+            DriveFrequency::Omega(w) => check(
+                "drive.omega",
+                w,
+                w > 0.0 && w <= MAX_OMEGA,
+                "a number in (0, 1e6] (rad/s)",
+            )?,
             DriveFrequency::R(r) => check("drive.r", r, r > 0.0, "a finite number > 0")?,
         }
         check(
@@ -174,13 +179,19 @@ impl Scene {
             self.gravity > 0.0,
             "a finite number > 0 (m/s²)",
         )?;
+        let angle_deg = crate::math::to_deg(self.initial_angle);
         check(
             "initial.angle_deg",
-            self.initial_angle,
-            true,
-            "a finite number",
+            angle_deg,
+            angle_deg.abs() <= crate::model::drive::MAX_ANGLE_DEG,
+            crate::model::drive::ANGLE_RANGE,
         )?;
-        check("initial.rate", self.initial_rate, true, "a finite number")?;
+        check(
+            "initial.rate",
+            self.initial_rate,
+            self.initial_rate.abs() <= MAX_OMEGA,
+            "a number in [-1e6, 1e6] (rad/s), no faster than the fastest drive",
+        )?;
         match self.length {
             RunLength::Periods(p) => check(
                 "run.periods",

@@ -22,6 +22,7 @@ use kapitza_core::integrate::{
     Symplectic, System,
 };
 use kapitza_core::math;
+use kapitza_core::model::drive::MAX_ANGLE_DEG;
 use kapitza_core::model::equilibria::{averaged_energy, effective_potential, margin};
 use kapitza_core::model::groups::omega_for_r;
 use kapitza_core::model::{equilibria, infer_r, Drive, DriveAngle, Geometry, Groups};
@@ -138,10 +139,15 @@ proptest! {
 
     #[test]
     fn hc09_drive_angle_and_drive(deg in bad(), a in or_good(0.0..0.05), w in or_good(1.0..500.0)) {
-        for angle in [DriveAngle::from_deg(deg), DriveAngle::from_rad(deg)] {
+        // Degrees beyond ±MAX_ANGLE_DEG are refused too: there the f64 angle no longer holds
+        // its position within a turn to any useful precision.
+        for (angle, limit) in [
+            (DriveAngle::from_deg(deg), MAX_ANGLE_DEG),
+            (DriveAngle::from_rad(deg), f64::INFINITY),
+        ] {
             match angle {
                 Err(e) => {
-                    prop_assert!(!deg.is_finite(), "finite {deg} refused");
+                    prop_assert!(!deg.is_finite() || deg.abs() > limit, "{deg} refused (limit {limit})");
                     names(&e, &["drive angle"])?;
                 }
                 Ok(d) => {
