@@ -17,7 +17,8 @@
 //! | [`averaging`] | 1 | inverted stable iff m > √(−2k); no upper end | fast drive, \|k\| ≪ 1, m ≪ 1 |
 //! | [`mathieu`] | 2 | boundaries from the small-q series of a0, b1, a1, b2 | \|q\| ≤ [`mathieu::Q_VALID`] |
 //! | [`harmonic_balance`] | 3 | Butikov's truncated Fourier systems: lower, flutter, order-n thresholds | the window's neighbourhood; error measured against Floquet |
-//! | [`floquet`] | 4 | the monodromy matrix over one period: exact for the linear equation | always (the reference) |
+//! | [`floquet`] | 4 | the monodromy matrix over one period: exact for the linear equation | always (the independent check) |
+//! | [`hill`] | 4 | the same verdict and boundaries from Hill's tridiagonal eigenproblems (Sturm counts), damping mapped on exactly | always (the reference `kapitza boundary` reports) |
 //!
 //! What each level costs and how far it is from Floquet (measured; tests in
 //! `tests/stability_agreement.rs` and `tests/stability_reference.rs`; times on the development
@@ -44,6 +45,7 @@
 pub mod averaging;
 pub mod floquet;
 pub mod harmonic_balance;
+pub mod hill;
 pub mod mathieu;
 
 use crate::error::ParamError;
