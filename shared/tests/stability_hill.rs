@@ -157,3 +157,36 @@ fn point_verdicts_match_monodromy_on_a_grid() {
         }
     }
 }
+
+#[test]
+fn bisected_first_window_agrees_with_the_walk() {
+    // Below the first tongue, first_window bisects the counts C ≥ 1, C ≥ 2, relying on a₀ and
+    // b₁ decreasing in q; the walk follows every crossing without that assumption. They must
+    // find the same ends (to the tolerance, 1e-10).
+    for i in 0..=40 {
+        let k = -3.0 + 3.2 * f64::from(i) / 40.0;
+        let (w, _, _) = hill::first_window(k, 10.0, 1e-12).unwrap();
+        let mut walk = hill::Windows::new(k, 10.0, 1e-12).unwrap();
+        let mut lower = walk.stable_at_start().then_some(0.0);
+        let mut upper = None;
+        for t in walk.by_ref() {
+            if !t.stable_before() && t.stable_after() && lower.is_none() {
+                lower = Some(t.m);
+            } else if t.stable_before() && !t.stable_after() {
+                upper = Some(t.m);
+                break;
+            }
+        }
+        if k >= 0.0 {
+            lower = Some(0.0);
+        }
+        assert!(
+            (val(w.lower) - lower.unwrap()).abs() < 1e-10,
+            "k {k}: {w:?} {lower:?}"
+        );
+        assert!(
+            (val(w.upper) - upper.unwrap()).abs() < 1e-10,
+            "k {k}: {w:?} {upper:?}"
+        );
+    }
+}

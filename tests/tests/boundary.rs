@@ -99,7 +99,9 @@ fn floquet_matches_the_printed_boundaries() {
         .unwrap()
         .matches(num(&f["upper_m"])));
     assert_eq!(f["includes_damping"], true);
-    assert!(num(&f["monodromies"]) > 0.0);
+    // Undamped, the ends come from Sturm counts of Hill's matrices: work, but no integration.
+    assert!(num(&f["sturm_counts"]) > 0.0);
+    assert_eq!(num(&f["monodromies"]), 0.0);
     let v = boundary(&["--k", "0"]);
     assert!(cases::K_ZERO
         .upper_cubic
@@ -154,6 +156,37 @@ fn damping_enters_floquet_only() {
     let by_c = boundary(&["--point", "0.2", "--omega", "60", "--damping", &c]);
     let by_q = boundary(&["--point", "0.2", "--omega", "60", "--q", "20"]);
     assert!((num(&by_c["delta"]) - num(&by_q["delta"])).abs() < 1e-15);
+}
+
+#[test]
+fn unconvergeable_steps_are_refused() {
+    // Damped, tr M is integrated: 3 steps per period cannot meet --tol 1e-7 (doubling them
+    // moves the ends by far more), so the command refuses rather than shift the reference.
+    let mut out = Vec::new();
+    let err = kapitza::run(
+        [
+            "kapitza", "boundary", "--k", "-0.3", "--q", "5", "--steps", "3",
+        ],
+        &mut out,
+    )
+    .expect_err("must refuse")
+    .to_string();
+    assert!(
+        err.contains("--steps") && err.contains("cannot be converged"),
+        "{err}"
+    );
+    // Undamped, --steps does not enter: the ends stay exact and a note says so.
+    let v = boundary(&["--k", "-0.3", "--steps", "3"]);
+    let f = criterion(&v, "floquet");
+    assert!(cases::K_MINUS_0_3
+        .upper_cubic
+        .unwrap()
+        .matches(num(&f["upper_m"])));
+    assert!(f["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|n| n.as_str().unwrap().contains("--steps does not apply")));
 }
 
 #[test]

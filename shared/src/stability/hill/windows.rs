@@ -11,9 +11,10 @@
 //! value being approached, and a tongue narrower than 5e-7 in m where a characteristic value
 //! stays within 2e-6 of a (steps never go below 1e-6 in q; that happens only at tongue tips).
 //!
-//! For the inverted position (k < 0) the first window is (a₀, b₁), and a₀(q), b₁(q) decrease
-//! monotonically (McLachlan §2.2; checked against the walk in the tests), so [`first_window`]
-//! bisects the counts "C ≥ 1" and "C ≥ 2" directly: about 90 Sturm counts per window.
+//! Below the first tongue (k < 1/4, which includes the inverted position) the first window is
+//! (a₀, b₁), and a₀(q), b₁(q) decrease monotonically (McLachlan §2.2; checked against the walk
+//! in the tests), so [`first_window`] bisects the counts "C ≥ 1" and "C ≥ 2" directly: about
+//! 90 Sturm counts per window.
 
 use super::{count_below, harmonics, stability_count};
 use crate::error::ParamError;
@@ -62,6 +63,8 @@ pub struct Windows {
     q_end: f64,
     tol_q: f64,
     count: u32,
+    /// The last certified gap: the next search starts from four times it.
+    last_gap: f64,
     /// Sturm counts spent (the work measure).
     pub counts: u64,
 }
@@ -85,6 +88,7 @@ impl Windows {
             q_end: 2.0 * m_max,
             tol_q: 2.0 * tol,
             count,
+            last_gap: 2.0,
             counts: 1,
         })
     }
@@ -99,13 +103,14 @@ impl Windows {
         stability_count(self.a, q)
     }
 
-    /// A lower bound on the distance from a to the nearest characteristic value at q, in
-    /// powers of two from 8 down to the tolerance.
+    /// A lower bound on the distance from a to the nearest characteristic value at q, halving
+    /// from four times the last one (at most 8) down to a quarter of the smallest step.
     fn gap(&mut self, q: f64) -> f64 {
         let n = harmonics(self.a + 8.0, q);
         let c = self.count;
+        let start = (4.0 * self.last_gap).clamp(MIN_STEP_Q, 8.0);
         let mut side = |sign: f64| {
-            let mut d = 8.0;
+            let mut d = start;
             while d > 0.25 * MIN_STEP_Q {
                 self.counts += 1;
                 let x = self.a + sign * d;
@@ -119,7 +124,9 @@ impl Windows {
             0.0
         };
         let below = if c == 0 { 8.0 } else { side(-1.0) };
-        below.min(side(1.0))
+        let gap = below.min(side(1.0));
+        self.last_gap = gap.max(MIN_STEP_Q);
+        gap
     }
 
     /// Bisects the first change of C in (lo, hi], given C(lo) = self.count ≠ C(hi).
@@ -192,8 +199,8 @@ impl Iterator for Windows {
 /// `m_max`, with whether its upper end is a flutter (tr M = −2) boundary.
 pub fn first_window(k: f64, m_max: f64, tol: f64) -> Result<(Window, bool, u64), ParamError> {
     let k = check_k(k)?;
-    if k < 0.0 {
-        return inverted_first(k, m_max, tol);
+    if k < 0.25 {
+        return below_first_tongue(k, m_max, tol);
     }
     let mut w = Windows::new(k, m_max, tol)?;
     // At k ≥ 0 the hanging position is stable without drive (k = 0: marginal, and stable for
@@ -221,8 +228,9 @@ fn window(lower: End, upper: End) -> Window {
     }
 }
 
-/// k < 0: the window (a₀, b₁) by bisecting the monotone counts C ≥ 1 and C ≥ 2.
-fn inverted_first(k: f64, m_max: f64, tol: f64) -> Result<(Window, bool, u64), ParamError> {
+/// k < 1/4 (a < 1): the window (a₀, b₁) by bisecting the monotone counts C ≥ 1 (for k < 0;
+/// for k ≥ 0, a₀(q) ≤ 0 ≤ a and the window starts at m = 0) and C ≥ 2.
+fn below_first_tongue(k: f64, m_max: f64, tol: f64) -> Result<(Window, bool, u64), ParamError> {
     let tol = check_tol(tol)?;
     let a = 4.0 * k;
     let q_end = 2.0 * m_max.min(M_MAX);
@@ -247,7 +255,12 @@ fn inverted_first(k: f64, m_max: f64, tol: f64) -> Result<(Window, bool, u64), P
         }
         Some(0.25 * (lo + hi))
     };
-    let w = match (first_at_least(1), first_at_least(2)) {
+    let lower = if k >= 0.0 {
+        Some(0.0)
+    } else {
+        first_at_least(1)
+    };
+    let w = match (lower, first_at_least(2)) {
         (None, _) => window(End::Missing(NEVER_STABLE), End::Missing(NEVER_STABLE)),
         (Some(l), None) => window(End::Value(l), End::Missing(STABLE_TO_LIMIT)),
         (Some(l), Some(u)) => window(End::Value(l), End::Value(u)),
