@@ -22,6 +22,7 @@ pub enum Command {
     Boundary(cmd::boundary::Args),
     Simulate(cmd::simulate::Args),
     Bench(cmd::bench::Args),
+    Chart(cmd::chart::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -78,6 +79,7 @@ where
         Command::Boundary(a) => cmd::boundary::run(&a, out)?,
         Command::Simulate(a) => cmd::simulate::run(&a, out)?,
         Command::Bench(a) => cmd::bench::run(&a, out)?,
+        Command::Chart(a) => cmd::chart::run(&a, out)?,
     }
     Ok(())
 }

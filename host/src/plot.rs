@@ -63,7 +63,7 @@ fn wrap_into(deg: f64, lo: f64) -> f64 {
     lo + (deg - lo).rem_euclid(360.0)
 }
 
-fn register() -> Result<()> {
+pub(crate) fn register() -> Result<()> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| register_font("sans-serif", FontStyle::Normal, FONT).is_ok());
     if ok {

@@ -2,5 +2,6 @@
 
 pub mod bench;
 pub mod boundary;
+pub mod chart;
 pub mod predict;
 pub mod simulate;

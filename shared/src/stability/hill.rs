@@ -47,7 +47,9 @@
 pub mod damped;
 pub mod windows;
 
-pub use damped::{damped_window, is_stable_damped, trace_u, DampedWindow, DEFAULT_HALF_STEPS};
+pub use damped::{
+    damped_window, is_stable_damped, trace_u, trace_u_with, DampedWindow, DEFAULT_HALF_STEPS,
+};
 pub use windows::{first_window, subharmonic_m, Transition, Windows};
 
 use super::{check_k, check_m};
