@@ -249,3 +249,91 @@ fn stability_chart_pendulum_form_matches_boundary() {
     assert!((num(&r["lower_amplitude"]) - num(&f["lower_amplitude"])).abs() < 2e-7);
     assert!((num(&r["lower_amplitude"]) - 0.5173).abs() < 5e-5);
 }
+
+#[test]
+fn outcome_shards_merge_into_the_whole_map() {
+    // Three shards of a 5×4 outcome map, merged, give exactly the cells (outcomes, angles,
+    // orders) of the map computed in one run; only the measured wall times differ.
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/sim_averaged_rest.toml"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let base = [
+        "kapitza",
+        "chart",
+        "outcomes",
+        scene,
+        "--x",
+        "drive.angle_deg=0..180",
+        "--y",
+        "drive.r=0.5..3",
+        "--size",
+        "5x4",
+        "--json",
+        "--out",
+    ];
+    let run = |extra: &[&str], out_dir: &str| -> Value {
+        let mut argv: Vec<&str> = base.to_vec();
+        argv.push(out_dir);
+        argv.extend_from_slice(extra);
+        let mut out = Vec::new();
+        kapitza::run(argv, &mut out).unwrap();
+        serde_json::from_slice(&out).unwrap()
+    };
+    let whole = run(&[], &format!("{d}/whole"));
+    for i in 0..3 {
+        run(&["--shard", &format!("{i}/3")], &format!("{d}/shards"));
+    }
+    let shard = |i: usize| format!("{d}/shards/outcomes-shard-{i}-of-3.json");
+    let (s0, s1, s2) = (shard(0), shard(1), shard(2));
+    let mut out = Vec::new();
+    kapitza::run(
+        [
+            "kapitza",
+            "chart",
+            "merge",
+            &s2,
+            &s0,
+            &s1,
+            "--json",
+            "--out",
+            &format!("{d}/merged"),
+        ],
+        &mut out,
+    )
+    .unwrap();
+    let merged: Value = serde_json::from_slice(&out).unwrap();
+    let strip = |v: &Value| -> Vec<Value> {
+        v["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                let mut c = c.clone();
+                c.as_object_mut().unwrap().remove("wall_s");
+                c
+            })
+            .collect()
+    };
+    assert_eq!(strip(&whole).len(), 20);
+    assert_eq!(strip(&whole), strip(&merged));
+    assert!(std::path::Path::new(&format!("{d}/merged/outcomes.png")).exists());
+    // A missing shard is refused, naming it.
+    let err = kapitza::run(
+        [
+            "kapitza",
+            "chart",
+            "merge",
+            &s0,
+            &s2,
+            "--out",
+            &format!("{d}/bad"),
+        ],
+        &mut Vec::new(),
+    )
+    .expect_err("must refuse")
+    .to_string();
+    assert!(err.contains("shard 1/3 is missing"), "{err}");
+}

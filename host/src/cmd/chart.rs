@@ -6,6 +6,7 @@ use std::io::Write;
 
 pub mod equilibria;
 pub mod options;
+pub mod outcomes;
 pub mod regions;
 pub mod stability;
 
@@ -21,6 +22,8 @@ pub enum Which {
     Equilibria(equilibria::Args),
     Regions(regions::Args),
     Stability(stability::Args),
+    Outcomes(outcomes::Args),
+    Merge(outcomes::MergeArgs),
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
@@ -28,5 +31,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         Which::Equilibria(a) => equilibria::run(a, out),
         Which::Regions(a) => regions::run(a, out),
         Which::Stability(a) => stability::run(a, out),
+        Which::Outcomes(a) => outcomes::run(a, out),
+        Which::Merge(a) => outcomes::merge(a, out),
     }
 }
