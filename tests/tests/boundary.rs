@@ -233,3 +233,29 @@ fn bad_input_names_the_argument() {
     )
     .is_err());
 }
+
+#[test]
+fn omega_window_for_a_given_stroke() {
+    // `--rod L --amplitude A` inverts the window: at the ω it reports as the lower (upper) end,
+    // the window in m found by `--omega` (bisected in m, tol 1e-7) has its lower (upper) end at
+    // exactly this A. Tolerance: 1e-7 in m, times ℓ = 0.1667 m, plus rounding: 5e-8 m.
+    let w = boundary(&["--rod", "0.25", "--amplitude", "0.09"]);
+    let f = |omega: f64| {
+        let v = boundary(&["--rod", "0.25", "--omega", &omega.to_string()]);
+        let fl = criterion(&v, "floquet");
+        (num(&fl["lower_amplitude"]), num(&fl["upper_amplitude"]))
+    };
+    let lo = num(&w["lower"]["omega"]);
+    assert!((f(lo).0 - 0.09).abs() < 5e-8, "{w}");
+    let hi = num(&w["upper"]["omega"]);
+    assert!((f(hi).1 - 0.09).abs() < 5e-8, "{w}");
+    // Units: Hz = ω/2π, rpm = 60 Hz.
+    assert!((num(&w["lower"]["hz"]) * std::f64::consts::TAU - lo).abs() < 1e-12 * lo);
+    assert!((num(&w["lower"]["rpm"]) - 60.0 * num(&w["lower"]["hz"])).abs() < 1e-9);
+    // ωc = √(2gℓ)/A (SPEC §3), ℓ = 2L/3.
+    let wc = (2.0 * 9.81 * 0.25 * 2.0 / 3.0f64).sqrt() / 0.09;
+    assert!((num(&w["omega_c"]) - wc).abs() < 1e-12 * wc);
+    // The demo rod's stroke (m = 0.076) never flutters: no upper end.
+    let demo = boundary(&["--rod", "0.25", "--amplitude", "0.0127"]);
+    assert!(demo["upper"].is_null());
+}

@@ -1,6 +1,8 @@
 //! `kapitza boundary`: the stability window in m = A/ℓ from every criterion of SPEC §4, each
 //! with its difference from Floquet and its measured cost.
 
+mod omega;
+
 use anyhow::{bail, Result};
 use serde::Serialize;
 use std::io::Write;
@@ -28,13 +30,18 @@ pub struct Args {
     /// Signed k = ±(ω0/ω)²: < 0 about the inverted position, > 0 about the hanging one.
     #[arg(long, value_name = "K", allow_negative_numbers = true,
           required_unless_present_any = ["rod", "point"],
-          conflicts_with_all = ["rod", "point", "omega", "damping", "hanging"])]
+          conflicts_with_all = ["rod", "point", "omega", "damping", "hanging", "amplitude"])]
     pub k: Option<f64>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive angular frequency ω (rad/s). With --rod or --point.
     #[arg(long, value_name = "W", allow_negative_numbers = true)]
     pub omega: Option<f64>,
+    /// Pivot amplitude A (m), half the stroke. With --rod or --point instead of --omega: the
+    /// window of ω (rad/s, Hz, rpm) in which that stroke holds the inverted position (exact,
+    /// undamped), with ωc explained.
+    #[arg(long, value_name = "A", allow_negative_numbers = true, conflicts_with_all = ["omega", "hanging", "damping", "quality"])]
+    pub amplitude: Option<f64>,
     /// Gravity g (m/s²). With --rod or --point.
     #[arg(
         long,
@@ -155,6 +162,20 @@ struct Problem {
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    if let (Some(a), Some(geometry)) = (args.amplitude, args.geometry.geometry()?) {
+        let w = omega::compute(
+            geometry.equivalent_length(),
+            input::positive("--amplitude", a)?,
+            input::positive("--gravity", args.gravity)?,
+        )?;
+        if args.json {
+            serde_json::to_writer_pretty(&mut *out, &w)?;
+            writeln!(out)?;
+        } else {
+            omega::print(&w, out)?;
+        }
+        return Ok(());
+    }
     let report = compute(args)?;
     if args.json {
         serde_json::to_writer_pretty(&mut *out, &report)?;
@@ -187,7 +208,7 @@ fn problem(args: &Args) -> Result<Problem> {
         bail!("give --k K, or a pendulum (--rod L or --point l) with --omega W");
     };
     let Some(omega) = args.omega else {
-        bail!("--rod/--point need --omega W (rad/s)");
+        bail!("--rod/--point need --omega W (rad/s), or --amplitude A (m) for the window in ω");
     };
     let omega = input::positive("--omega", omega)?;
     let gravity = input::positive("--gravity", args.gravity)?;
