@@ -127,7 +127,8 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         let phi = rest_angle::check(phi)?;
         let r = match args.r {
             Some(r) => Some(input::non_negative("--r", r)?),
-            None => drive_groups(args)?.map(|g| g.r),
+            None => input::drive_groups(&args.geometry, args.amplitude, args.omega, args.gravity)?
+                .map(|g| g.r),
         };
         let a = rest_angle::compute(phi, r)?;
         if args.json {
@@ -146,25 +147,6 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         print_table(&report, out)?;
     }
     Ok(())
-}
-
-/// The pendulum's groups, when a pendulum and drive were given.
-fn drive_groups(args: &Args) -> Result<Option<Groups>> {
-    let Some(geometry) = args.geometry.geometry()? else {
-        return Ok(None);
-    };
-    let (Some(a), Some(w)) = (args.amplitude, args.omega) else {
-        bail!("--rod/--point need --amplitude A (m) and --omega W (rad/s)");
-    };
-    let g = Groups::new(
-        geometry.equivalent_length(),
-        input::positive("--gravity", args.gravity)?,
-        input::positive("--amplitude", a)?,
-        input::positive("--omega", w)?,
-        0.0,
-    )
-    .context("pendulum and drive")?;
-    Ok(Some(g))
 }
 
 pub fn compute(args: &Args) -> Result<Report> {

@@ -10,7 +10,7 @@ use super::options::{write_csv, Output, Range};
 use crate::chart::draw::{self, pe, tint, Figure, SERIES};
 use crate::chart::map::samples;
 use crate::input::{self, GeometryArgs};
-use kapitza_core::model::{equilibria, DriveAngle, Groups, Stability};
+use kapitza_core::model::{equilibria, DriveAngle, Stability};
 
 /// φ0 against θd for the R values given: every equilibrium of the averaged motion, stable
 /// branches solid, unstable dashed, and the reachable side (within 90° of the drive) shaded.
@@ -82,20 +82,8 @@ fn label(s: Stability) -> &'static str {
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let dir = args.output.prepare()?;
-    let rs = match args.geometry.geometry()? {
-        Some(geometry) => {
-            let (Some(a), Some(w)) = (args.amplitude, args.omega) else {
-                bail!("--rod/--point need --amplitude A (m) and --omega W (rad/s)");
-            };
-            let g = Groups::new(
-                geometry.equivalent_length(),
-                input::positive("--gravity", args.gravity)?,
-                input::positive("--amplitude", a)?,
-                input::positive("--omega", w)?,
-                0.0,
-            )?;
-            vec![g.r]
-        }
+    let rs = match input::drive_groups(&args.geometry, args.amplitude, args.omega, args.gravity)? {
+        Some(g) => vec![g.r],
         None => {
             for &r in &args.r {
                 input::non_negative("--r", r)?;
