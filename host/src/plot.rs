@@ -107,7 +107,7 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// Title, subtitle and a legend line of (sample, text) entries.
 fn header(area: &Area, title: &str, subtitle: &str, legend: &[(Sample, String)]) -> Result<()> {
-    let e = |e| anyhow!("{e:?}");
+    let e = |e| anyhow!("{e}");
     area.draw(&Text::new(
         title.to_string(),
         (14, 6),
