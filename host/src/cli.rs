@@ -33,6 +33,7 @@ pub enum Command {
     Rig(cmd::rig_serve::Args),
     Monitor(cmd::monitor::Args),
     Demo(cmd::demo::Args),
+    Chart(cmd::chart::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -103,6 +104,7 @@ where
         Command::Rig(a) => cmd::rig_serve::run(&a, out)?,
         Command::Monitor(a) => cmd::monitor::run(&a, out)?,
         Command::Demo(a) => cmd::demo::run(&a, out)?,
+        Command::Chart(a) => cmd::chart::run(&a, out)?,
     }
     Ok(())
 }

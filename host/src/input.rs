@@ -5,7 +5,7 @@
 
 use anyhow::{bail, Result};
 use clap::Args;
-use kapitza_core::model::Geometry;
+use kapitza_core::model::{Geometry, Groups};
 
 pub fn positive(flag: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
@@ -56,4 +56,29 @@ impl GeometryArgs {
             _ => None,
         })
     }
+}
+
+/// The groups of the pendulum given by `geometry` under the drive (`--amplitude`, `--omega`),
+/// undamped; `None` without a pendulum.
+pub fn drive_groups(
+    geometry: &GeometryArgs,
+    amplitude: Option<f64>,
+    omega: Option<f64>,
+    gravity: f64,
+) -> Result<Option<Groups>> {
+    let Some(geometry) = geometry.geometry()? else {
+        return Ok(None);
+    };
+    let (Some(a), Some(w)) = (amplitude, omega) else {
+        bail!("--rod/--point need --amplitude A (m) and --omega W (rad/s)");
+    };
+    let g = Groups::new(
+        geometry.equivalent_length(),
+        positive("--gravity", gravity)?,
+        positive("--amplitude", a)?,
+        positive("--omega", w)?,
+        0.0,
+    )
+    .map_err(|e| anyhow::anyhow!("pendulum and drive: {e}"))?;
+    Ok(Some(g))
 }

@@ -63,7 +63,7 @@ fn wrap_into(deg: f64, lo: f64) -> f64 {
     lo + (deg - lo).rem_euclid(360.0)
 }
 
-fn register() -> Result<()> {
+pub(crate) fn register() -> Result<()> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| register_font("sans-serif", FontStyle::Normal, FONT).is_ok());
     if ok {
@@ -107,7 +107,7 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// Title, subtitle and a legend line of (sample, text) entries.
 fn header(area: &Area, title: &str, subtitle: &str, legend: &[(Sample, String)]) -> Result<()> {
-    let e = |e| anyhow!("{e:?}");
+    let e = |e| anyhow!("{e}");
     area.draw(&Text::new(
         title.to_string(),
         (14, 6),

@@ -185,3 +185,41 @@ fn out_without_a_sensor_writes_no_sensed_csv() {
         assert!(text(&out.stdout).contains(&format!("wrote {}", dir.path().join(f).display())));
     }
 }
+
+#[test]
+fn unwritable_out_is_refused_before_the_run_and_set_is_flagged() {
+    // --out under a regular file cannot be created: refused in plain words, before any output
+    // of a run (no summary on stdout).
+    let scene = data("sim_averaged_rest.toml");
+    let scene = scene.to_str().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let blocker = dir.path().join("file");
+    std::fs::write(&blocker, b"").unwrap();
+    let out_dir = blocker.join("out");
+    let r = kapitza(&["simulate", scene, "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(1));
+    assert!(
+        text(&r.stderr).contains("cannot create the output directory"),
+        "{}",
+        text(&r.stderr)
+    );
+    assert!(r.stdout.is_empty(), "{}", text(&r.stdout));
+    // --set keeps the file's title and [expect]: the summary says so.
+    let r = kapitza(&["simulate", scene, "--set", "drive.angle_deg=120"]);
+    assert!(
+        text(&r.stdout).contains("the title and [expect] are the file's"),
+        "{}",
+        text(&r.stdout)
+    );
+    // Piping into a reader that stops early is not an error.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kapitza"))
+        .args(["chart", "regions", "--size", "5x5", "--json", "--out"])
+        .arg(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let done = child.wait_with_output().unwrap();
+    assert_eq!(done.status.code(), Some(0), "{}", text(&done.stderr));
+}

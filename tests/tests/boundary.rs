@@ -99,7 +99,9 @@ fn floquet_matches_the_printed_boundaries() {
         .unwrap()
         .matches(num(&f["upper_m"])));
     assert_eq!(f["includes_damping"], true);
-    assert!(num(&f["monodromies"]) > 0.0);
+    // Undamped, the ends come from Sturm counts of Hill's matrices: work, but no integration.
+    assert!(num(&f["sturm_counts"]) > 0.0);
+    assert_eq!(num(&f["monodromies"]), 0.0);
     let v = boundary(&["--k", "0"]);
     assert!(cases::K_ZERO
         .upper_cubic
@@ -157,6 +159,37 @@ fn damping_enters_floquet_only() {
 }
 
 #[test]
+fn unconvergeable_steps_are_refused() {
+    // Damped, tr M is integrated: 3 steps per period cannot meet --tol 1e-7 (doubling them
+    // moves the ends by far more), so the command refuses rather than shift the reference.
+    let mut out = Vec::new();
+    let err = kapitza::run(
+        [
+            "kapitza", "boundary", "--k", "-0.3", "--q", "5", "--steps", "3",
+        ],
+        &mut out,
+    )
+    .expect_err("must refuse")
+    .to_string();
+    assert!(
+        err.contains("--steps") && err.contains("cannot be converged"),
+        "{err}"
+    );
+    // Undamped, --steps does not enter: the ends stay exact and a note says so.
+    let v = boundary(&["--k", "-0.3", "--steps", "3"]);
+    let f = criterion(&v, "floquet");
+    assert!(cases::K_MINUS_0_3
+        .upper_cubic
+        .unwrap()
+        .matches(num(&f["upper_m"])));
+    assert!(f["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|n| n.as_str().unwrap().contains("--steps does not apply")));
+}
+
+#[test]
 fn hanging_position_window_starts_at_zero() {
     // About the hanging position every criterion's window starts at m = 0; at k = 0.1 the first
     // tongue (b1, period 2) ends it: Floquet and harmonic balance agree to 1e-6.
@@ -199,4 +232,30 @@ fn bad_input_names_the_argument() {
         &mut out
     )
     .is_err());
+}
+
+#[test]
+fn omega_window_for_a_given_stroke() {
+    // `--rod L --amplitude A` inverts the window: at the ω it reports as the lower (upper) end,
+    // the window in m found by `--omega` (bisected in m, tol 1e-7) has its lower (upper) end at
+    // exactly this A. Tolerance: 1e-7 in m, times ℓ = 0.1667 m, plus rounding: 5e-8 m.
+    let w = boundary(&["--rod", "0.25", "--amplitude", "0.09"]);
+    let f = |omega: f64| {
+        let v = boundary(&["--rod", "0.25", "--omega", &omega.to_string()]);
+        let fl = criterion(&v, "floquet");
+        (num(&fl["lower_amplitude"]), num(&fl["upper_amplitude"]))
+    };
+    let lo = num(&w["lower"]["omega"]);
+    assert!((f(lo).0 - 0.09).abs() < 5e-8, "{w}");
+    let hi = num(&w["upper"]["omega"]);
+    assert!((f(hi).1 - 0.09).abs() < 5e-8, "{w}");
+    // Units: Hz = ω/2π, rpm = 60 Hz.
+    assert!((num(&w["lower"]["hz"]) * std::f64::consts::TAU - lo).abs() < 1e-12 * lo);
+    assert!((num(&w["lower"]["rpm"]) - 60.0 * num(&w["lower"]["hz"])).abs() < 1e-9);
+    // ωc = √(2gℓ)/A (SPEC §3), ℓ = 2L/3.
+    let wc = (2.0 * 9.81 * 0.25 * 2.0 / 3.0f64).sqrt() / 0.09;
+    assert!((num(&w["omega_c"]) - wc).abs() < 1e-12 * wc);
+    // The demo rod's stroke (m = 0.076) never flutters: no upper end.
+    let demo = boundary(&["--rod", "0.25", "--amplitude", "0.0127"]);
+    assert!(demo["upper"].is_null());
 }

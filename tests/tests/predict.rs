@@ -157,3 +157,30 @@ fn bad_input_names_the_argument() {
         assert!(out.is_empty(), "nothing printed on error");
     }
 }
+
+#[test]
+fn rest_angle_answers_which_drive_angle() {
+    // Closed forms (SPEC §3 solved for θd): a rest at φ0 needs |sin 2(φ0 − θd)| = 2|sin φ0|/R
+    // ≤ 1, so R ≥ 2 sin φ0, reached at φ0 − θd = −45° where the margin cos φ0 > 0 for
+    // φ0 = 60°; R is unbounded above (θd → φ0). Tolerance 1e-8: the scan over φ0 − θd is
+    // flat (quadratic) at its minimum.
+    let v = predict(&["--rest-angle", "60"]);
+    assert!((v["r_min"].as_f64().unwrap() - 2.0 * 60f64.to_radians().sin()).abs() < 1e-8);
+    assert!(v["r_max"].is_null());
+    // R = 1.75: the equilibrium at arccos(1/R) = 55.15° needs θd = 90° (SPEC §4 table); the
+    // other root of sin 2x (θd = 110.3°) is unstable there, and the x + 180° roots unreachable.
+    let phi = (1.0f64 / 1.75).acos().to_degrees();
+    let v = predict(&["--rest-angle", &phi.to_string(), "--r", "1.75"]);
+    let angles: Vec<f64> = v["drive_angles_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_f64().unwrap())
+        .collect();
+    assert_eq!(angles.len(), 1, "{v}");
+    assert!((angles[0] - 90.0).abs() < 1e-9, "{v}");
+    // Too weak a drive: none, and the reason says how strong it must be.
+    let v = predict(&["--rest-angle", "60", "--r", "0.5"]);
+    assert!(v["drive_angles_deg"].as_array().unwrap().is_empty());
+    assert!(v["reason"].as_str().unwrap().contains("at least 1.73"));
+}

@@ -1,6 +1,8 @@
 //! `kapitza boundary`: the stability window in m = A/ℓ from every criterion of SPEC §4, each
 //! with its difference from Floquet and its measured cost.
 
+mod omega;
+
 use anyhow::{bail, Result};
 use serde::Serialize;
 use std::io::Write;
@@ -9,9 +11,7 @@ use std::time::Duration;
 use crate::input::{self, GeometryArgs};
 use crate::timing::seconds_per_eval;
 use kapitza_core::model::Groups;
-use kapitza_core::stability::{
-    averaging, floquet::Floquet, harmonic_balance, mathieu, End, Window, K_MAX,
-};
+use kapitza_core::stability::{averaging, harmonic_balance, hill, mathieu, End, Window, K_MAX};
 
 /// Subharmonic orders reported (n = 2 is the flutter boundary).
 const ORDERS: std::ops::RangeInclusive<u32> = 2..=8;
@@ -30,13 +30,18 @@ pub struct Args {
     /// Signed k = ±(ω0/ω)²: < 0 about the inverted position, > 0 about the hanging one.
     #[arg(long, value_name = "K", allow_negative_numbers = true,
           required_unless_present_any = ["rod", "point"],
-          conflicts_with_all = ["rod", "point", "omega", "damping", "hanging"])]
+          conflicts_with_all = ["rod", "point", "omega", "damping", "hanging", "amplitude"])]
     pub k: Option<f64>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive angular frequency ω (rad/s). With --rod or --point.
     #[arg(long, value_name = "W", allow_negative_numbers = true)]
     pub omega: Option<f64>,
+    /// Pivot amplitude A (m), half the stroke. With --rod or --point instead of --omega: the
+    /// window of ω (rad/s, Hz, rpm) in which that stroke holds the inverted position (exact,
+    /// undamped), with ωc explained.
+    #[arg(long, value_name = "A", allow_negative_numbers = true, conflicts_with_all = ["omega", "hanging", "damping", "quality"])]
+    pub amplitude: Option<f64>,
     /// Gravity g (m/s²). With --rod or --point.
     #[arg(
         long,
@@ -67,9 +72,11 @@ pub struct Args {
     /// Floquet: tolerance on each boundary in m.
     #[arg(long, value_name = "TOL", default_value_t = 1e-7)]
     pub tol: f64,
-    /// Floquet: RK4 steps per drive period of each monodromy matrix.
-    #[arg(long, value_name = "N", default_value_t = kapitza_core::stability::floquet::DEFAULT_STEPS)]
-    pub steps: u32,
+    /// Floquet with damping: RK4 steps per drive period of tr M (default 1000; integrated over
+    /// half a period). Undamped ends come from Hill's determinant and need no steps. Refused
+    /// when doubling it moves an end by more than --tol: such a setting cannot be converged.
+    #[arg(long, value_name = "N")]
+    pub steps: Option<u32>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -121,11 +128,15 @@ pub struct Criterion {
     /// Harmonic balance only: the truncated (A5 dropped) flutter formula.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub upper_m_truncated: Option<f64>,
-    /// Floquet only: monodromy matrices and right-hand-side evaluations one window took.
+    /// Floquet only: integrations of tr M (half a period each; none undamped) and their
+    /// right-hand-side evaluations one window took.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub monodromies: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rhs_evals: Option<u64>,
+    /// Floquet only: Sturm counts of Hill's tridiagonal matrices one window took.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sturm_counts: Option<u64>,
 }
 
 #[derive(Debug, Serialize)]
@@ -151,6 +162,20 @@ struct Problem {
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    if let (Some(a), Some(geometry)) = (args.amplitude, args.geometry.geometry()?) {
+        let w = omega::compute(
+            geometry.equivalent_length(),
+            input::positive("--amplitude", a)?,
+            input::positive("--gravity", args.gravity)?,
+        )?;
+        if args.json {
+            serde_json::to_writer_pretty(&mut *out, &w)?;
+            writeln!(out)?;
+        } else {
+            omega::print(&w, out)?;
+        }
+        return Ok(());
+    }
     let report = compute(args)?;
     if args.json {
         serde_json::to_writer_pretty(&mut *out, &report)?;
@@ -183,7 +208,7 @@ fn problem(args: &Args) -> Result<Problem> {
         bail!("give --k K, or a pendulum (--rod L or --point l) with --omega W");
     };
     let Some(omega) = args.omega else {
-        bail!("--rod/--point need --omega W (rad/s)");
+        bail!("--rod/--point need --omega W (rad/s), or --amplitude A (m) for the window in ω");
     };
     let omega = input::positive("--omega", omega)?;
     let gravity = input::positive("--gravity", args.gravity)?;
@@ -216,20 +241,63 @@ fn problem(args: &Args) -> Result<Problem> {
     })
 }
 
+/// Largest m searched for the Floquet window (the rig's m is well below 1).
+const M_SEARCH: f64 = 10.0;
+
+/// The Floquet window with its work: (window, tr M integrations, rhs evaluations, Sturm counts).
+fn floquet_window(
+    k: f64,
+    delta: f64,
+    tol: f64,
+    half_steps: u32,
+) -> Result<(Window, u64, u64, u64)> {
+    if delta == 0.0 {
+        let (w, _, counts) = hill::first_window(k, M_SEARCH, tol)?;
+        return Ok((w, 0, 0, counts));
+    }
+    let d = hill::damped_window(k, delta, tol, half_steps)?;
+    let evals = d.traces * 4 * u64::from(half_steps);
+    Ok((d.window, d.traces, evals, d.counts))
+}
+
+/// Refuses a step count whose damped ends move by more than `tol` when it is doubled.
+fn check_converged(k: f64, delta: f64, tol: f64, half_steps: u32, w: &Window) -> Result<()> {
+    let (finer, ..) = floquet_window(k, delta, tol, 2 * half_steps)?;
+    for (end, a, b) in [
+        ("lower", w.lower, finer.lower),
+        ("upper", w.upper, finer.upper),
+    ] {
+        if let (Some(a), Some(b)) = (a.value(), b.value()) {
+            if (a - b).abs() > tol {
+                bail!(
+                    "--steps {} cannot be converged: doubling it moves the Floquet {end} end \
+                     by {:.1e} (more than --tol {tol:e}); use more steps (default 1000)",
+                    2 * half_steps,
+                    (a - b).abs()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 pub fn compute(args: &Args) -> Result<Report> {
     let p = problem(args)?;
     let tol = input::positive("--tol", args.tol)?;
-    if args.steps == 0 {
-        bail!("--steps 0 is out of range: expected at least 1");
+    let steps = args.steps.unwrap_or(2 * hill::DEFAULT_HALF_STEPS);
+    if steps < 2 {
+        bail!("--steps {steps} is out of range: expected at least 2");
     }
-    let floquet = Floquet::new(args.steps)?;
+    let half_steps = steps / 2;
     let (k, delta) = (p.k, p.delta);
     let ell = p.physical.as_ref().map(|ph| ph.equivalent_length);
     let undamped = (delta > 0.0).then_some("undamped value: only Floquet includes damping");
 
-    let fw = floquet.window(k, delta, tol)?;
-    let f_cost = seconds_per_eval(BATCH, || floquet.window(k, delta, tol));
-    let reference = fw.value;
+    let (reference, traces, evals, counts) = floquet_window(k, delta, tol, half_steps)?;
+    if delta > 0.0 {
+        check_converged(k, delta, tol, half_steps, &reference)?;
+    }
+    let f_cost = seconds_per_eval(BATCH, || floquet_window(k, delta, tol, half_steps));
 
     let mut criteria = vec![
         criterion(
@@ -260,14 +328,18 @@ pub fn compute(args: &Args) -> Result<Report> {
     criteria[2].upper_m_truncated = harmonic_balance::truncated_upper(k)?.value();
     let mut f = criterion("floquet", reference, &reference, ell, None, f_cost);
     f.includes_damping = true;
-    f.monodromies = Some(fw.monodromies);
-    f.rhs_evals = Some(fw.stats.rhs_evals);
+    f.monodromies = Some(traces);
+    f.rhs_evals = Some(evals);
+    f.sturm_counts = Some(counts);
+    if delta == 0.0 && args.steps.is_some() {
+        f.notes.push(STEPS_UNUSED);
+    }
     criteria.push(f);
 
     let mut subharmonics = Vec::new();
     for n in ORDERS {
         let hb = harmonic_balance::subharmonic_m(k, n)?;
-        let fl = floquet.subharmonic_m(k, n, tol)?.value;
+        let fl = hill::subharmonic_m(k, n, tol)?;
         subharmonics.push(Subharmonic {
             order: n,
             m: hb.value(),
@@ -321,8 +393,13 @@ fn criterion(
         upper_m_truncated: None,
         monodromies: None,
         rhs_evals: None,
+        sturm_counts: None,
     }
 }
+
+/// Note: `--steps` given for an undamped problem.
+const STEPS_UNUSED: &str =
+    "--steps does not apply: undamped ends come from Hill's determinant (no integration)";
 
 fn fmt_opt(x: Option<f64>, prec: usize) -> String {
     x.map_or("—".into(), |v| format!("{v:.prec$}"))

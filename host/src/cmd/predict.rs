@@ -1,5 +1,7 @@
 //! `kapitza predict`: every equilibrium of the averaged motion, with its stability.
 
+mod rest_angle;
+
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::io::Write;
@@ -18,12 +20,23 @@ use kapitza_core::model::{equilibria, DriveAngle, Equilibrium, Groups, Stability
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Drive strength R = A²ω²/(2gℓ) (>= 0).
-    #[arg(long = "r", value_name = "R", allow_negative_numbers = true, required_unless_present_any = ["rod", "point"], conflicts_with_all = ["rod", "point", "amplitude", "omega"])]
+    #[arg(long = "r", value_name = "R", allow_negative_numbers = true, required_unless_present_any = ["rod", "point", "rest_angle"], conflicts_with_all = ["rod", "point", "amplitude", "omega"])]
     pub r: Option<f64>,
     /// Drive angle θd in degrees from the downward vertical (0 shakes vertically, 90
     /// horizontally, 180 vertically along the upward direction).
+    #[arg(
+        long,
+        value_name = "DEG",
+        allow_negative_numbers = true,
+        required_unless_present = "rest_angle",
+        conflicts_with = "rest_angle"
+    )]
+    pub angle: Option<f64>,
+    /// Instead of --angle: the wanted rest angle φ0 (degrees). Prints every drive angle that
+    /// puts a stable equilibrium within 90° of the drive there (at the R given, if any), and the
+    /// range of R for which one exists — or says that none does.
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
-    pub angle: f64,
+    pub rest_angle: Option<f64>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive amplitude A (m): half the peak-to-peak stroke. With --rod or --point.
@@ -112,6 +125,22 @@ impl EquilibriumOut {
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    if let Some(phi) = args.rest_angle {
+        let phi = rest_angle::check(phi)?;
+        let r = match args.r {
+            Some(r) => Some(input::non_negative("--r", r)?),
+            None => input::drive_groups(&args.geometry, args.amplitude, args.omega, args.gravity)?
+                .map(|g| g.r),
+        };
+        let a = rest_angle::compute(phi, r)?;
+        if args.json {
+            serde_json::to_writer_pretty(&mut *out, &a)?;
+            writeln!(out)?;
+        } else {
+            rest_angle::print(&a, out)?;
+        }
+        return Ok(());
+    }
     let report = compute(args)?;
     if args.json {
         serde_json::to_writer_pretty(&mut *out, &report)?;
@@ -123,7 +152,10 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
 }
 
 pub fn compute(args: &Args) -> Result<Report> {
-    let angle_deg = input::finite("--angle", args.angle)?;
+    let Some(angle) = args.angle else {
+        bail!("give --angle DEG (or --rest-angle DEG)");
+    };
+    let angle_deg = input::finite("--angle", angle)?;
     if angle_deg.abs() > MAX_ANGLE_DEG {
         bail!(
             "--angle {} is out of range: expected {ANGLE_RANGE}",

@@ -51,6 +51,9 @@ pub struct Summary {
     /// The scene file as given.
     pub scene: String,
     pub title: String,
+    /// The `--set` overrides: the title and `[expect]` are the file's, written for the scene
+    /// without them.
+    pub sets: Vec<String>,
     pub outcome: OutcomeOut,
     /// The scene's `[expect]` with `met`; `null` when the scene has none.
     pub expect: Option<Judged>,
@@ -135,6 +138,10 @@ fn fidelity_name(f: Fidelity) -> &'static str {
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let file = scene_file::load(&args.scene, &args.set)?;
     let name = args.scene.display().to_string();
+    // An unwritable --out must not throw away a whole run: checked before it.
+    if let Some(dir) = &args.out {
+        crate::chart::draw::prepare_dir(dir)?;
+    }
     let p = file.scene.physical().map_err(|e| anyhow!("{name}: {e}"))?;
     let duration = file.scene.duration(p.omega);
     let out_dt = if args.out.is_some() {
@@ -155,7 +162,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let wall = start.elapsed().as_secs_f64();
     rec.finish();
     let report = result.map_err(|e| anyhow!("{name}: {e}"))?;
-    let summary = summarise(&name, &file, &report, wall)?;
+    let summary = summarise(&name, &file, &args.set, &report, wall)?;
     let mut written = Vec::new();
     if let Some(dir) = &args.out {
         written = write_out(dir, &file, &summary, &rec)?;
@@ -182,7 +189,13 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     Ok(())
 }
 
-fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result<Summary> {
+fn summarise(
+    name: &str,
+    file: &SceneFile,
+    sets: &[String],
+    report: &Report,
+    wall: f64,
+) -> Result<Summary> {
     let p = &report.physical;
     let scene = &file.scene;
     let outcome = OutcomeOut::from(report.outcome);
@@ -212,6 +225,7 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
     Ok(Summary {
         scene: name.to_string(),
         title: file.title.clone(),
+        sets: sets.to_vec(),
         expect: file.expect.as_ref().map(|e| e.judge(&outcome)),
         outcome,
         fidelity: FidelityOut {
@@ -264,6 +278,13 @@ fn summarise(name: &str, file: &SceneFile, report: &Report, wall: f64) -> Result
 
 fn print_summary(s: &Summary, report: &Report, out: &mut dyn Write) -> Result<()> {
     writeln!(out, "{}  ({})", s.title, s.scene)?;
+    if !s.sets.is_empty() {
+        writeln!(
+            out,
+            "with --set {}: the title and [expect] are the file's, written for the scene without it",
+            s.sets.join(", ")
+        )?;
+    }
     writeln!(
         out,
         "drive: R = {:.4}, ω = {:.2} rad/s, θd = {}°, A = {} m; ℓ = {:.4} m, ω0 = {:.3} rad/s (ω/ω0 = {:.1})",
@@ -369,8 +390,13 @@ fn write_out(dir: &Path, file: &SceneFile, s: &Summary, rec: &Collect) -> Result
         .outcome
         .angle_deg()
         .unwrap_or_else(|| outcome::deg(rec.series.last().map_or(0.0, |x| x[1])));
+    let title = if s.sets.is_empty() {
+        s.title.clone()
+    } else {
+        format!("{} — changed by --set {}", s.title, s.sets.join(", "))
+    };
     let input = plot::PlotInput {
-        title: &s.title,
+        title: &title,
         subtitle: format!(
             "R = {:.3}, θd = {}°, ω = {:.1} rad/s, {} model, {}  —  outcome: {}",
             s.r, s.drive_angle_deg, s.omega, s.fidelity.used, s.method, s.outcome

@@ -27,7 +27,8 @@ pub struct Prediction {
 pub fn predict(cfg: &RigConfig, r: f64, theta_d_deg: f64) -> Option<Prediction> {
     let args = Args {
         r: Some(r),
-        angle: theta_d_deg,
+        angle: Some(theta_d_deg),
+        rest_angle: None,
         geometry: GeometryArgs {
             rod: None,
             point: None,
