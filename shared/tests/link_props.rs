@@ -17,7 +17,9 @@ fn fault() -> impl Strategy<Value = Fault> {
     prop_oneof![
         Just(Fault::EStop),
         Just(Fault::OverCurrent),
-        Just(Fault::Stall)
+        Just(Fault::Stall),
+        Just(Fault::Sensor),
+        Just(Fault::WrongDirection)
     ]
 }
 

@@ -92,6 +92,7 @@ proptest! {
                             crank_speed: RadPerSec::saturating_from_num(dds.omega().to_num::<f64>() * crank_frac),
                             ref_omega: dds.omega(),
                             drive_stopped: dds.is_stopped(),
+                            sensor_failed: false,
                             link_us: t,
                         };
                         let out = sup.check(t, &inp);
@@ -137,6 +138,7 @@ fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
         crank_speed: RadPerSec::from_num(crank),
         ref_omega: RadPerSec::from_num(ref_omega),
         drive_stopped: stopped,
+        sensor_failed: false,
         link_us: 0,
     }
 }
@@ -234,6 +236,19 @@ fn drive_angle_slews_within_the_travel() {
     assert!((s.theta_d().to_deg() + 5.0).abs() < 1e-6);
 }
 
+/// 300 control ticks (1 ms apart, the link alive) on `inp` leave the rig running; the 301st
+/// halts it (the REFERENCE stall debounce: 300 ms).
+fn latches_after_300_ticks(s: &mut Supervisor, t: &mut u32, inp: &Inputs) {
+    for _ in 0..300 {
+        *t += 1000;
+        s.heard_from_link(*t);
+        check(s, *t, inp);
+        assert_eq!(s.mode(), Mode::Running, "t = {t}");
+    }
+    *t += 1000;
+    assert!(check(s, *t, inp).halt);
+}
+
 #[test]
 fn stall_and_over_current_stop_after_their_debounce() {
     let cfg = RigConfig::REFERENCE;
@@ -241,14 +256,7 @@ fn stall_and_over_current_stop_after_their_debounce() {
     s.request(Request::Start { omega: 300.0 }).unwrap();
     // Crank at 10 % of the reference: stall after 300 ms, not before.
     let mut t = 0;
-    for _ in 0..300 {
-        t += 1000;
-        s.heard_from_link(t);
-        check(&mut s, t, &quiet(100.0, 10.0, false));
-        assert_eq!(s.mode(), Mode::Running, "t = {t}");
-    }
-    t += 1000;
-    assert!(check(&mut s, t, &quiet(100.0, 10.0, false)).halt);
+    latches_after_300_ticks(&mut s, &mut t, &quiet(100.0, 10.0, false));
     assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
     s.request(Request::ClearFault).unwrap();
     s.request(Request::Start { omega: 300.0 }).unwrap();
@@ -263,4 +271,64 @@ fn stall_and_over_current_stop_after_their_debounce() {
     t += 1000;
     check(&mut s, t, &inp);
     assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
+}
+
+#[test]
+fn a_crank_turning_backwards_faults_after_the_stall_debounce() {
+    // Swapped encoder channels or motor leads: the crank follows the drive at full speed, but
+    // backwards. |speed| is above the stall bar, so only the sign can catch it; the debounce is
+    // the stall's (REFERENCE: 300 ms at 1 kHz ticks, so 300 ticks pass and the 301st latches).
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut t = 0;
+    latches_after_300_ticks(&mut s, &mut t, &quiet(100.0, -100.0, false));
+    assert_eq!(s.mode(), Mode::Faulted(Fault::WrongDirection));
+    assert_eq!(
+        s.request(Request::Start { omega: 300.0 }),
+        Err(Refusal::Faulted(Fault::WrongDirection))
+    );
+    // Backwards but slower than the bar (30 % of 100 rad/s): a stall, not a wrong direction.
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    for _ in 0..301 {
+        t += 1000;
+        s.heard_from_link(t);
+        check(&mut s, t, &quiet(100.0, -20.0, false));
+    }
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
+    // Forwards at speed: neither.
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    for _ in 0..1000 {
+        t += 1000;
+        s.heard_from_link(t);
+        check(&mut s, t, &quiet(100.0, 100.0, false));
+    }
+    assert_eq!(s.mode(), Mode::Running);
+}
+
+#[test]
+fn a_failed_sensor_latches_in_any_mode_and_refuses_a_start() {
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    let mut inp = quiet(0.0, 0.0, true);
+    inp.sensor_failed = true;
+    assert!(check(&mut s, 1000, &inp).halt);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Sensor));
+    assert_eq!(
+        s.request(Request::Start { omega: 100.0 }),
+        Err(Refusal::Faulted(Fault::Sensor))
+    );
+    // Once the sensor is back, the fault clears and a start is taken.
+    check(&mut s, 2000, &quiet(0.0, 0.0, true));
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 100.0 }).unwrap();
+    assert_eq!(s.mode(), Mode::Running);
+    // While running: halted at once.
+    s.heard_from_link(3000);
+    let mut inp = quiet(50.0, 50.0, false);
+    inp.sensor_failed = true;
+    assert!(check(&mut s, 3000, &inp).halt);
+    assert_eq!(s.last_stop(), Some(StopReason::Fault(Fault::Sensor)));
 }

@@ -201,6 +201,8 @@ fn fault_name(f: &Fault) -> &'static str {
         Fault::EStop => "estop",
         Fault::OverCurrent => "over_current",
         Fault::Stall => "stall",
+        Fault::Sensor => "sensor",
+        Fault::WrongDirection => "wrong_direction",
     }
 }
 

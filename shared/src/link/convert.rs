@@ -37,6 +37,8 @@ impl From<safety::Fault> for Fault {
             safety::Fault::EStop => Self::EStop,
             safety::Fault::OverCurrent => Self::OverCurrent,
             safety::Fault::Stall => Self::Stall,
+            safety::Fault::Sensor => Self::Sensor,
+            safety::Fault::WrongDirection => Self::WrongDirection,
         }
     }
 }

@@ -207,6 +207,8 @@ pub enum Fault {
     EStop,
     OverCurrent,
     Stall,
+    Sensor,
+    WrongDirection,
 }
 
 /// [`crate::model::RMethod`].

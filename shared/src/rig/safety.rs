@@ -11,15 +11,17 @@
 //!   Idle ───────────────────────▶ Running ───────────────────────────────▶ Stopping ─▶ Idle
 //!    ▲                               │  SetOmega (ramped), SetDriveAngle (slewed)      (when the
 //!    │ ClearFault (e-stop released)  │                                                  drive is 0)
-//!    └──────────── Faulted ◀─────────┴── e-stop, over-current, stall (from any state): drive
-//!                                        halted at once, duty 0, latched
+//!    └──────────── Faulted ◀─────────┴── e-stop, over-current, stall, wrong direction, sensor
+//!                                        (from any state): drive halted at once, duty 0, latched
 //! ```
 //! A drive strength R from the laptop becomes ω = ωc√R through [`RigConfig::omega_for_r`]
 //! before it reaches the supervisor (SPEC §7: "setting R means computing ω from R, A and ℓ").
 //! Limits: ω ≤ ω_max (refused above); |dω/dt| ≤ the ramp rate (the drive generator's step, not
 //! a request); |dθd/dt| ≤ its limit (slewed here); θd inside the mount's travel (refused
 //! outside). Over-current: I > I_max for `overcurrent_ms`. Stall: commanded ω ≥ `stall_min_omega`
-//! and crank speed < `stall_fraction`·commanded for `stall_ms`.
+//! and crank speed < `stall_fraction`·commanded for `stall_ms`. Wrong direction: the same
+//! commanded speed while the crank turns backwards faster than `stall_fraction`·commanded for
+//! `stall_ms`. Sensor: the pendulum sensor's driver reports it failed.
 //!
 //! # When the laptop link goes silent
 //!
@@ -103,10 +105,17 @@ impl core::fmt::Display for Refusal {
 
 /// A latched fault: the drive is halted until [`Request::ClearFault`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Fault {
     EStop,
     OverCurrent,
     Stall,
+    /// The pendulum sensor gave no good angle for too long, or reports its magnet out of range
+    /// ([`super::as5047::Health::failed`]).
+    Sensor,
+    /// The crank turns against the drive: swapped encoder channels or motor leads. The phase
+    /// lock would push it to full duty; caught like a stall, by sign.
+    WrongDirection,
 }
 
 /// Why the drive last stopped.
@@ -135,6 +144,8 @@ pub struct Inputs {
     pub ref_omega: RadPerSec,
     /// The drive generator has reached zero frequency.
     pub drive_stopped: bool,
+    /// The pendulum sensor has failed ([`super::as5047::Health::failed`]).
+    pub sensor_failed: bool,
     /// The link's clock now (µs, wrapping), the clock [`Supervisor::heard_from_link`] is given.
     /// On the rig it is `now_us`; a simulated rig running faster than real time gives wall time,
     /// so the link-silence timeout stays what it says.
@@ -165,6 +176,7 @@ pub struct Supervisor {
     last_link_us: u32,
     over_since: Option<u32>,
     stall_since: Option<u32>,
+    reverse_since: Option<u32>,
     estop_seen: bool,
     // limits, fixed at construction
     omega_max: f64,
@@ -196,6 +208,7 @@ impl Supervisor {
             last_link_us: now_us,
             over_since: None,
             stall_since: None,
+            reverse_since: None,
             estop_seen: false,
             omega_max: l.omega_max,
             theta_min_deg: l.drive_angle_min_deg,
@@ -264,6 +277,7 @@ impl Supervisor {
                 self.mode = Mode::Running;
                 self.target_word = w;
                 self.stall_since = None;
+                self.reverse_since = None;
             }
             Request::SetOmega { omega } => {
                 let w = self.check_omega(omega)?;
@@ -296,6 +310,7 @@ impl Supervisor {
                     self.mode = Mode::Idle;
                     self.over_since = None;
                     self.stall_since = None;
+                    self.reverse_since = None;
                 }
             }
         }
@@ -327,19 +342,28 @@ impl Supervisor {
         } else {
             self.over_since = None;
         }
-        // Stall: driving hard but the crank does not follow.
+        if inp.sensor_failed && !matches!(self.mode, Mode::Faulted(_)) {
+            self.fault(Fault::Sensor);
+        }
+        // Stall: driving hard but the crank does not follow. Wrong direction: it follows
+        // backwards (the drive reference is never negative), at least as fast as a stall is slow.
         let driving = matches!(self.mode, Mode::Running | Mode::Stopping(_));
         let want = inp.ref_omega.saturating_abs();
         let got = inp.crank_speed.saturating_abs();
-        let slow =
-            i64::from(got.to_bits()) * 65_536 < i64::from(want.to_bits()) * self.stall_frac_q16;
-        if driving && want >= self.stall_min && slow {
-            let since = *self.stall_since.get_or_insert(now_us);
-            if elapsed_us(since, now_us) >= self.stall_us {
-                self.fault(Fault::Stall);
-            }
-        } else {
-            self.stall_since = None;
+        let bar = i64::from(want.to_bits()) * self.stall_frac_q16;
+        let slow = i64::from(got.to_bits()) * 65_536 < bar;
+        let backwards = i64::from(inp.crank_speed.to_bits()) * 65_536 <= -bar;
+        let armed = driving && want >= self.stall_min;
+        if held(&mut self.stall_since, armed && slow, now_us, self.stall_us) {
+            self.fault(Fault::Stall);
+        }
+        if held(
+            &mut self.reverse_since,
+            armed && backwards,
+            now_us,
+            self.stall_us,
+        ) {
+            self.fault(Fault::WrongDirection);
         }
         // Link silence: soft stop.
         if self.mode == Mode::Running && elapsed_us(self.last_link_us, inp.link_us) > self.link_us {
@@ -374,4 +398,14 @@ impl Supervisor {
             theta_d: self.theta,
         }
     }
+}
+
+/// A condition debounced by time: true once it has held for `for_us` since `since` (set when it
+/// began, cleared when it stops).
+fn held(since: &mut Option<u32>, cond: bool, now_us: u32, for_us: u32) -> bool {
+    if !cond {
+        *since = None;
+        return false;
+    }
+    elapsed_us(*since.get_or_insert(now_us), now_us) >= for_us
 }

@@ -154,6 +154,18 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
         s.config = o;
         v.push((name, 150 + i as u8, Resp(Response::Status(s))));
     }
+    // The faults a bench latches, each as a status.
+    for (i, (name, f)) in [
+        ("status_faulted_sensor", Fault::Sensor),
+        ("status_faulted_wrong_direction", Fault::WrongDirection),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut s = status();
+        s.mode = Mode::Faulted(f);
+        v.push((name, 170 + i as u8, Resp(Response::Status(s))));
+    }
     v
 }
 
