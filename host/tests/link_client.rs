@@ -272,6 +272,20 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
             other => panic!("{other:?}"),
         }
     }
+    // A motor too weak for the set ω: 300 rad/s at full duty (back-EMF matched, so its current
+    // stays low) against ω = ωc√3 = 313 rad/s. The crank runs at ≥ 96 % of ω, no stall, but
+    // slips a cycle every 2π/13 s ≈ 0.48 s once the ramp (313/60 ≈ 5.2 s) is over: two slips
+    // within 1 s lose the lock ≈ 6.2 s after the start; 10 s is the bound.
+    let weak = Params {
+        motor: kapitza_core::simrig::plant::MotorModel {
+            omega_per_duty: 300.0,
+            ke: 12.0 / 300.0,
+            ..kapitza_core::simrig::plant::MotorModel::DEFAULT
+        },
+        ..Params::DEMO
+    };
+    let (_, mode) = faulted_within(weak, SensorLine::Connected, true, 10_000);
+    assert_eq!(mode, Mode::Faulted(Fault::PhaseLockLost));
     // The same rig wired right runs.
     let (_, mode) = faulted_within(Params::DEMO, SensorLine::Connected, true, 2000);
     assert_eq!(mode, Mode::Running);

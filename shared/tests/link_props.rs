@@ -19,7 +19,9 @@ fn fault() -> impl Strategy<Value = Fault> {
         Just(Fault::OverCurrent),
         Just(Fault::Stall),
         Just(Fault::Sensor),
-        Just(Fault::WrongDirection)
+        Just(Fault::WrongDirection),
+        Just(Fault::PhaseLockLost),
+        Just(Fault::OverCurrentRms)
     ]
 }
 

@@ -203,6 +203,8 @@ fn fault_name(f: &Fault) -> &'static str {
         Fault::Stall => "stall",
         Fault::Sensor => "sensor",
         Fault::WrongDirection => "wrong_direction",
+        Fault::PhaseLockLost => "phase_lock_lost",
+        Fault::OverCurrentRms => "over_current_rms",
     }
 }
 

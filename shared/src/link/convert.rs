@@ -39,6 +39,8 @@ impl From<safety::Fault> for Fault {
             safety::Fault::Stall => Self::Stall,
             safety::Fault::Sensor => Self::Sensor,
             safety::Fault::WrongDirection => Self::WrongDirection,
+            safety::Fault::PhaseLockLost => Self::PhaseLockLost,
+            safety::Fault::OverCurrentRms => Self::OverCurrentRms,
         }
     }
 }

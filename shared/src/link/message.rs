@@ -209,6 +209,8 @@ pub enum Fault {
     Stall,
     Sensor,
     WrongDirection,
+    PhaseLockLost,
+    OverCurrentRms,
 }
 
 /// [`crate::model::RMethod`].

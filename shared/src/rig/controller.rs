@@ -39,6 +39,7 @@ pub struct Rig {
     est: Estimator,
     sup: Supervisor,
     sensor_failed: bool,
+    phase_error: RadPerSec,
 }
 
 impl Rig {
@@ -51,6 +52,7 @@ impl Rig {
             est: Estimator::new(cfg, tuning, theta_d0),
             sup: Supervisor::new(cfg, theta_d0, now_us),
             sensor_failed: false,
+            phase_error: RadPerSec::ZERO,
         }
     }
 
@@ -100,6 +102,8 @@ impl Rig {
             ref_omega: self.dds.omega(),
             drive_stopped: self.dds.is_stopped(),
             sensor_failed: self.sensor_failed,
+            phase_error: self.phase_error,
+            ramping: self.dds.is_ramping(),
             link_us,
         };
         let out = self.sup.check(t_us, &inputs);
@@ -119,6 +123,7 @@ impl Rig {
             crank,
         );
         motor.set_duty(lock.duty);
+        self.phase_error = lock.error;
         let steady = run
             && !self.dds.is_ramping()
             && self.dds.word() > 0

@@ -24,12 +24,14 @@ pub struct Retained {
     pub last_fault: Option<Fault>,
 }
 
-const FAULTS: [Fault; 5] = [
+const FAULTS: [Fault; 7] = [
     Fault::EStop,
     Fault::OverCurrent,
     Fault::Stall,
     Fault::Sensor,
     Fault::WrongDirection,
+    Fault::PhaseLockLost,
+    Fault::OverCurrentRms,
 ];
 
 fn crc(words: &[u32; 3]) -> u32 {

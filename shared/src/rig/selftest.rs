@@ -211,6 +211,8 @@ fn safety_script() -> u64 {
                 ref_omega: RadPerSec::from_num(100),
                 drive_stopped: k > 600,
                 sensor_failed: false,
+                phase_error: RadPerSec::ZERO,
+                ramping: false,
                 link_us: t,
             };
             let o = s.check(t, &inp);
@@ -370,21 +372,28 @@ fn bench_faults() -> u64 {
     let cfg = RigConfig::REFERENCE;
     let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
     let mut t = 0u32;
-    for (i, speed) in [-100i32, -20, 100].into_iter().enumerate() {
+    for (i, speed) in [-100i32, -20, 100, 100, 100].into_iter().enumerate() {
         d.u32(u32::from(s.request(Request::ClearFault).is_ok()));
         d.u32(u32::from(
             s.request(Request::Start { omega: 300.0 }).is_ok(),
         ));
-        for k in 0..400u32 {
+        for k in 0..800u32 {
             t = t.wrapping_add(1000);
             s.heard_from_link(t);
             let inp = Inputs {
                 estop: false,
-                current: RadPerSec::ZERO,
+                // Segment 3 slips a cycle every 150 ticks; segment 4 draws 2.5 A (I²t).
+                current: RadPerSec::from_num(if i == 4 { 2.5 } else { 0.0 }),
                 crank_speed: RadPerSec::from_num(speed),
                 ref_omega: RadPerSec::from_num(100),
                 drive_stopped: false,
-                sensor_failed: i == 2 && k == 399,
+                sensor_failed: i == 2 && k == 799,
+                phase_error: RadPerSec::from_num(match (i, k % 150) {
+                    (3, 0) => 3.0,
+                    (3, 1) => -3.0,
+                    _ => 0.0,
+                }),
+                ramping: false,
                 link_us: t,
             };
             let o = s.check(t, &inp);
@@ -440,6 +449,6 @@ pub const CASES: &[Case] = &[
     Case {
         name: "bench_faults",
         run: bench_faults,
-        expected: 0x6e79_13c3_f915_3bda,
+        expected: 0x6296_a4a2_a9d5_b4f5,
     },
 ];

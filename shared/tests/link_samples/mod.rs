@@ -158,6 +158,8 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
     for (i, (name, f)) in [
         ("status_faulted_sensor", Fault::Sensor),
         ("status_faulted_wrong_direction", Fault::WrongDirection),
+        ("status_faulted_phase_lock_lost", Fault::PhaseLockLost),
+        ("status_faulted_over_current_rms", Fault::OverCurrentRms),
     ]
     .into_iter()
     .enumerate()
