@@ -24,6 +24,7 @@ use defmt::{info, unwrap, warn};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::pac;
+use kapitza_core::link::message::{ResetCause, ResetInfo};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::servo;
 
@@ -41,7 +42,8 @@ async fn main(spawner: Spawner) {
     // chip) and TIM1 (whose outputs are then disabled, as if MOE were cleared).
     pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     pac::DBGMCU.apb2fzr().modify(|w| w.set_tim1(true));
-    info!("reset cause: {=str}", reset_cause());
+    let cause = reset_cause();
+    info!("reset cause: {}", cause);
     let kept = retained::load();
     if let Some(k) = kept {
         info!(
@@ -63,8 +65,12 @@ async fn main(spawner: Spawner) {
 
     let control = CONTROL_EXECUTOR.start(board::CONTROL_IRQ);
     control.spawn(unwrap!(tasks::pendulum::run(b.pendulum, cfg.sample_hz)));
+    let reset = ResetInfo {
+        cause,
+        last_fault: kept.and_then(|k| k.last_fault).map(Into::into),
+    };
     control.spawn(unwrap!(tasks::control::run(
-        b.drive, cfg, origin, theta_d0, kept
+        b.drive, cfg, origin, theta_d0, kept, reset
     )));
 
     spawner.spawn(unwrap!(tasks::tilt::run(b.tilt)));
@@ -74,24 +80,22 @@ async fn main(spawner: Spawner) {
 }
 
 /// Why the chip last reset (RCC_CSR's flags, cleared here so the next reset reports its own).
-fn reset_cause() -> &'static str {
+/// A power-on sets BORRSTF and PINRSTF together (RM0440, "RCC_CSR"): brown-out is checked
+/// before the pin.
+fn reset_cause() -> ResetCause {
     let csr = pac::RCC.csr().read();
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
     if csr.iwdgrstf() {
-        "independent watchdog"
-    } else if csr.wwdgrstf() {
-        "window watchdog"
+        ResetCause::Watchdog
     } else if csr.sftrstf() {
-        "software"
-    } else if csr.lpwrrstf() {
-        "low-power"
-    } else if csr.oblrstf() {
-        "option-byte load"
+        ResetCause::Software
+    } else if csr.wwdgrstf() || csr.lpwrrstf() || csr.oblrstf() {
+        ResetCause::Other
     } else if csr.borrstf() {
-        "power-on / brown-out"
+        ResetCause::PowerOn
     } else if csr.pinrstf() {
-        "reset pin"
+        ResetCause::Pin
     } else {
-        "unknown"
+        ResetCause::Other
     }
 }

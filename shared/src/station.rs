@@ -31,7 +31,7 @@
 //! **An unknown e-stop line counts as pressed**: the rig cannot start blind.
 
 use crate::link::frame::{decode_request_as, encode, open, Header};
-use crate::link::message::Counters;
+use crate::link::message::{Counters, ResetInfo};
 use crate::link::serve::{Clock, Effect, RigServer};
 use crate::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 use crate::persist::ConfigOrigin;
@@ -187,6 +187,12 @@ impl RigLoop {
             uptime_us: 0,
             current: Amps::ZERO,
         }
+    }
+
+    /// The same rig after a reset of `cause`, reported in the status.
+    pub fn after_reset(mut self, reset: ResetInfo) -> Self {
+        self.srv.reset = reset;
+        self
     }
 
     /// The same rig speaking protocol `version` on the link: for tests of what a host does

@@ -16,6 +16,7 @@
 //! The loop is clocked by the samples, so the DDS advances exactly once per sample and the
 //! estimator sees each sample with the drive phase of the same tick.
 
+use kapitza_core::link::message::ResetInfo;
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::{Amps, Angle, Duty};
@@ -69,7 +70,7 @@ impl Motor for Hw<'_> {
 }
 
 /// `theta_d0`: where the servo starts (`kapitza_core::rig::servo::power_up_deg`); `kept`: what
-/// the firmware left before the last reset.
+/// the firmware left before the last reset; `reset`: its cause and last fault, for the status.
 #[embassy_executor::task]
 pub async fn run(
     mut drive: Drive,
@@ -77,9 +78,11 @@ pub async fn run(
     origin: ConfigOrigin,
     theta_d0: f64,
     kept: Option<Retained>,
+    reset: ResetInfo,
 ) {
     let t0 = embassy_time::Instant::now().as_micros() as u32;
-    let mut rig = RigLoop::new(cfg, origin, Angle::from_deg(theta_d0), t0, FIRMWARE);
+    let mut rig =
+        RigLoop::new(cfg, origin, Angle::from_deg(theta_d0), t0, FIRMWARE).after_reset(reset);
     let mut keep = Retained {
         theta_d_deg: theta_d0 as f32,
         last_fault: kept.and_then(|k| k.last_fault),

@@ -2,7 +2,8 @@
 //! round-trip, size and golden-frame tests.
 
 use kapitza_core::link::message::{
-    Counters, Fault, Mode, RMethod, StopReason, Telemetry, VersionInfo, WireConfig, WireGeometry,
+    Counters, Fault, Mode, RMethod, ResetCause, ResetInfo, StopReason, Telemetry, VersionInfo,
+    WireConfig, WireGeometry,
 };
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{Reason, Request, Response, Status};
@@ -38,6 +39,10 @@ pub fn status() -> Status {
             overruns: 1,
             frames_dropped: 2,
             commands: 77,
+        },
+        reset: ResetInfo {
+            cause: ResetCause::Watchdog,
+            last_fault: Some(Fault::PhaseLockLost),
         },
     }
 }
