@@ -25,6 +25,9 @@ pub async fn run(mut bus: PendulumBus, sample_hz: u32) {
     let mut sensor = As5047::new();
     let mut held = Angle::ZERO;
     let mut late = false;
+    // The sensor answers 10 ms after its supply comes up (AS5047P datasheet, "power-up time"
+    // tPwrUp); frames before that would count towards a sensor fault at every boot.
+    Timer::after_millis(10).await;
     // Prime the pipeline: the first answer belongs to no command of ours.
     let t0 = Instant::now();
     sensor.sample(t0.as_micros() as u32, |w| bus.transfer(w));
