@@ -23,10 +23,9 @@ pub static FROM_LAPTOP: Pipe<Cs, 256> = Pipe::new();
 pub static LINE_ERROR: Signal<Cs, ()> = Signal::new();
 /// control → link: frame bytes for the laptop (answers and telemetry).
 pub static TO_LAPTOP: Pipe<Cs, 512> = Pipe::new();
-/// control → tilt: the slew-limited θd, degrees along the mount's travel.
+/// control → tilt: the slew-limited θd, degrees along the mount's travel (the first one is the
+/// power-up θd: the tilt task sends no pulse before it).
 pub static THETA_D: Signal<Cs, f64> = Signal::new();
-/// safety → control: the e-stop input is active.
-pub static ESTOP: Watch<Cs, bool, 1> = Watch::new();
 /// control → safety: the control loop completed a tick (the watchdog is fed only then).
 pub static HEARTBEAT: Signal<Cs, ()> = Signal::new();
 /// control → persist: a configuration was accepted; store it.

@@ -16,12 +16,17 @@
 
 mod board;
 mod channels;
+mod fail_safe;
+mod retained;
 mod tasks;
 
 use defmt::{info, unwrap, warn};
+use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::pac;
+use kapitza_core::link::message::{ResetCause, ResetInfo};
 use kapitza_core::persist::ConfigOrigin;
-use {defmt_rtt as _, panic_probe as _};
+use kapitza_core::rig::servo;
 
 /// Firmware version, from this crate's Cargo.toml.
 const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -33,6 +38,19 @@ pub static CONTROL_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 async fn main(spawner: Spawner) {
     let p = embassy_stm32::init(board::chip_config());
     info!("kapitza firmware v{=str} on {=str}", VERSION, board::NAME);
+    // A debugger halting the core freezes the watchdog (so a breakpoint does not reset the
+    // chip) and TIM1 (whose outputs are then disabled, as if MOE were cleared).
+    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
+    pac::DBGMCU.apb2fzr().modify(|w| w.set_tim1(true));
+    let cause = reset_cause();
+    info!("reset cause: {}", cause);
+    let kept = retained::load();
+    if let Some(k) = kept {
+        info!(
+            "before the reset: theta_d = {=f32} deg, last fault {}",
+            k.theta_d_deg, k.last_fault
+        );
+    }
     let mut b = board::split(p);
 
     let (cfg, origin) = tasks::persist::load(&mut b.flash);
@@ -40,16 +58,44 @@ async fn main(spawner: Spawner) {
         ConfigOrigin::Stored => info!("configuration: stored"),
         other => warn!("configuration: safe defaults ({})", other),
     }
-    // The first e-stop reading and the sample rate, before any task can ask for them.
-    channels::ESTOP.sender().send(b.safety.estop_active());
+    // The sample rate, before any task can ask for it.
     channels::SAMPLE_HZ.sender().send(cfg.sample_hz);
+    // θd at power-up: the one commanded before a reset, else the park angle.
+    let theta_d0 = servo::power_up_deg(kept.map(|k| f64::from(k.theta_d_deg)), &cfg);
 
     let control = CONTROL_EXECUTOR.start(board::CONTROL_IRQ);
     control.spawn(unwrap!(tasks::pendulum::run(b.pendulum, cfg.sample_hz)));
-    control.spawn(unwrap!(tasks::control::run(b.drive, cfg, origin)));
+    let reset = ResetInfo {
+        cause,
+        last_fault: kept.and_then(|k| k.last_fault).map(Into::into),
+    };
+    control.spawn(unwrap!(tasks::control::run(
+        b.drive, cfg, origin, theta_d0, kept, reset
+    )));
 
     spawner.spawn(unwrap!(tasks::tilt::run(b.tilt)));
     spawner.spawn(unwrap!(tasks::safety::run(b.safety)));
     spawner.spawn(unwrap!(tasks::link::run(b.uart)));
     spawner.spawn(unwrap!(tasks::persist::run(b.flash)));
+}
+
+/// Why the chip last reset (RCC_CSR's flags, cleared here so the next reset reports its own).
+/// A power-on sets BORRSTF and PINRSTF together (RM0440, "RCC_CSR"): brown-out is checked
+/// before the pin.
+fn reset_cause() -> ResetCause {
+    let csr = pac::RCC.csr().read();
+    pac::RCC.csr().modify(|w| w.set_rmvf(true));
+    if csr.iwdgrstf() {
+        ResetCause::Watchdog
+    } else if csr.sftrstf() {
+        ResetCause::Software
+    } else if csr.wwdgrstf() || csr.lpwrrstf() || csr.oblrstf() {
+        ResetCause::Other
+    } else if csr.borrstf() {
+        ResetCause::PowerOn
+    } else if csr.pinrstf() {
+        ResetCause::Pin
+    } else {
+        ResetCause::Other
+    }
 }

@@ -1,6 +1,8 @@
 //! Everything that reads bytes from outside: the frame reader, both decoders, the stored
-//! configuration record. None may panic on any input; a frame that decodes must re-encode to
-//! the same payload (no two encodings of one message slip through the strict decoder).
+//! configuration record, the pendulum sensor's answers (the AS5047P driver) and the words kept
+//! in RAM across a reset. None may panic on any input; a frame that decodes must re-encode to
+//! the same payload (no two encodings of one message slip through the strict decoder); the
+//! sensor driver reports an angle only with its failure run reset.
 
 #![no_main]
 
@@ -38,4 +40,20 @@ fuzz_target!(|data: &[u8]| {
     let _ = receive_request(&mut whole[..n].to_owned());
     let _ = receive_response(&mut whole[..n]);
     let _ = kapitza_core::persist::load(data);
+    // As the sensor's answers on MISO, two bytes a frame (the bus may also fail: a missing word).
+    let mut sensor = kapitza_core::rig::as5047::As5047::new();
+    let mut words = data
+        .chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]));
+    for k in 0..data.len() / 2 {
+        let r = sensor.sample(k as u32 * 100, |_| words.next().ok_or(()));
+        if r.count.is_ok() {
+            assert_eq!(sensor.health().bad_run, 0);
+        }
+    }
+    // As the retained RAM after a reset.
+    if let Some(b) = data.get(..16) {
+        let w = |i: usize| u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+        let _ = kapitza_core::rig::retained::decode([w(0), w(4), w(8), w(12)]);
+    }
 });

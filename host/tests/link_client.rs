@@ -12,6 +12,7 @@ use kapitza_core::persist::{ConfigOrigin, Fallback};
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::Angle;
 use kapitza_core::rig::safety;
+use kapitza_core::simrig::sensor::Line as SensorLine;
 use kapitza_core::simrig::{Params, SimRig};
 
 const CFG: RigConfig = RigConfig::REFERENCE;
@@ -217,4 +218,75 @@ fn version_skew_is_reported_not_guessed() {
         }
         other => panic!("{other:?}"),
     }
+}
+
+/// A rig on `params` with its sensor line as given, after `ms` of polling its status (each poll
+/// lets ≥ 1 ms of rig time pass), or earlier once it faults.
+fn faulted_within(params: Params, wire: SensorLine, start: bool, ms: u32) -> (Client<Line>, Mode) {
+    let mut rig = SimRig::new(params, CFG, ConfigOrigin::Stored, [0, 1, 0]);
+    rig.sensor().line = wire;
+    let mut c = client(Line::on(rig));
+    if start {
+        c.set_drive(3.0, 0.0).unwrap();
+    }
+    let mut mode = c.status().unwrap().mode;
+    for _ in 0..ms {
+        if matches!(mode, Mode::Faulted(_)) {
+            break;
+        }
+        mode = c.status().unwrap().mode;
+    }
+    (c, mode)
+}
+
+#[test]
+fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
+    use kapitza_core::link::message::Fault;
+    // A cut sensor cable (MISO pulled up): faulted while idle, within FAULT_AFTER samples.
+    let (mut c, mode) = faulted_within(Params::DEMO, SensorLine::CutPulledUp, false, 50);
+    assert_eq!(mode, Mode::Faulted(Fault::Sensor));
+    match c.set_drive(3.0, 0.0) {
+        Err(Error::Refused(Reason::Faulted(Fault::Sensor))) => {}
+        other => panic!("{other:?}"),
+    }
+    // Swapped crank-encoder channels, and swapped motor leads: the crank turns against the
+    // drive; with the reference limits (ramp 60 rad/s², bar at 20 rad/s, 300 ms debounce) the
+    // fault comes ≈ 0.65 s after the start; 3 s is the bound.
+    for params in [
+        Params {
+            crank_sign: -1.0,
+            ..Params::DEMO
+        },
+        Params {
+            motor: kapitza_core::simrig::plant::MotorModel {
+                direction: -1.0,
+                ..kapitza_core::simrig::plant::MotorModel::DEFAULT
+            },
+            ..Params::DEMO
+        },
+    ] {
+        let (mut c, mode) = faulted_within(params, SensorLine::Connected, true, 3000);
+        assert_eq!(mode, Mode::Faulted(Fault::WrongDirection));
+        match c.set_drive(3.0, 0.0) {
+            Err(Error::Refused(Reason::Faulted(Fault::WrongDirection))) => {}
+            other => panic!("{other:?}"),
+        }
+    }
+    // A motor too weak for the set ω: 300 rad/s at full duty (back-EMF matched, so its current
+    // stays low) against ω = ωc√3 = 313 rad/s. The crank runs at ≥ 96 % of ω, no stall, but
+    // slips a cycle every 2π/13 s ≈ 0.48 s once the ramp (313/60 ≈ 5.2 s) is over: two slips
+    // within 1 s lose the lock ≈ 6.2 s after the start; 10 s is the bound.
+    let weak = Params {
+        motor: kapitza_core::simrig::plant::MotorModel {
+            omega_per_duty: 300.0,
+            ke: 12.0 / 300.0,
+            ..kapitza_core::simrig::plant::MotorModel::DEFAULT
+        },
+        ..Params::DEMO
+    };
+    let (_, mode) = faulted_within(weak, SensorLine::Connected, true, 10_000);
+    assert_eq!(mode, Mode::Faulted(Fault::PhaseLockLost));
+    // The same rig wired right runs.
+    let (_, mode) = faulted_within(Params::DEMO, SensorLine::Connected, true, 2000);
+    assert_eq!(mode, Mode::Running);
 }

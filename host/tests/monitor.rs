@@ -37,6 +37,7 @@ fn status(mode: Mode, omega_target: f64, theta_d_target: f64, commands: u32) -> 
             commands,
             ..Counters::default()
         },
+        reset: kapitza_core::link::message::ResetInfo::POWER_ON,
     }
 }
 

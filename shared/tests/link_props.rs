@@ -4,7 +4,8 @@
 
 use kapitza_core::link::frame::{encode, open, receive_request, receive_response, Header};
 use kapitza_core::link::message::{
-    Counters, Fault, Mode, RMethod, StopReason, Telemetry, WireConfig, WireGeometry,
+    Counters, Fault, Mode, RMethod, ResetCause, ResetInfo, StopReason, Telemetry, WireConfig,
+    WireGeometry,
 };
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{
@@ -17,7 +18,11 @@ fn fault() -> impl Strategy<Value = Fault> {
     prop_oneof![
         Just(Fault::EStop),
         Just(Fault::OverCurrent),
-        Just(Fault::Stall)
+        Just(Fault::Stall),
+        Just(Fault::Sensor),
+        Just(Fault::WrongDirection),
+        Just(Fault::PhaseLockLost),
+        Just(Fault::OverCurrentRms)
     ]
 }
 
@@ -157,8 +162,9 @@ fn status() -> impl Strategy<Value = Status> {
         (mode(), proptest::option::of(stop_reason()), any::<bool>()),
         (any::<i32>(), any::<i32>(), any::<i32>(), any::<i32>()),
         (origin(), any::<u32>(), any::<[u32; 6]>()),
+        (reset_cause(), proptest::option::of(fault())),
     )
-        .prop_map(|(a, b, c)| Status {
+        .prop_map(|(a, b, c, r)| Status {
             mode: a.0,
             last_stop: a.1,
             estop: a.2,
@@ -176,7 +182,21 @@ fn status() -> impl Strategy<Value = Status> {
                 frames_dropped: c.2[4],
                 commands: c.2[5],
             },
+            reset: ResetInfo {
+                cause: r.0,
+                last_fault: r.1,
+            },
         })
+}
+
+fn reset_cause() -> impl Strategy<Value = ResetCause> {
+    prop_oneof![
+        Just(ResetCause::PowerOn),
+        Just(ResetCause::Pin),
+        Just(ResetCause::Watchdog),
+        Just(ResetCause::Software),
+        Just(ResetCause::Other)
+    ]
 }
 
 fn telemetry() -> impl Strategy<Value = Telemetry> {

@@ -227,6 +227,10 @@ fn status_and_telemetry_in_wire_units() {
         },
     )
     .unwrap();
+    let after_watchdog = kapitza_core::link::message::ResetInfo {
+        cause: kapitza_core::link::message::ResetCause::Watchdog,
+        last_fault: Some(kapitza_core::link::message::Fault::Stall),
+    };
     let s = status(
         &r,
         &CFG,
@@ -234,8 +238,10 @@ fn status_and_telemetry_in_wire_units() {
         ConfigOrigin::Defaults(Fallback::Missing),
         42,
         Counters::default(),
+        after_watchdog,
     );
     assert_eq!(s.mode, Mode::Running);
+    assert_eq!(s.reset, after_watchdog);
     // θd targets are degrees along the travel [−10°, 190°]: 190° stays 190°, not −170°.
     assert!((from_q16(s.theta_d_target_deg) - 190.0).abs() < 1e-4);
     assert!((from_q16(s.omega_target) - CFG.omega_for_r(3.0).unwrap()).abs() < 1e-3);

@@ -75,6 +75,7 @@ impl Bench {
                 angle: Angle::ZERO,
                 failed: false,
                 late: false,
+                sensor_failed: false,
             });
             if due {
                 let tick = self.rig.control(self.link_us, &mut self.crank, self.estop);

@@ -92,6 +92,9 @@ proptest! {
                             crank_speed: RadPerSec::saturating_from_num(dds.omega().to_num::<f64>() * crank_frac),
                             ref_omega: dds.omega(),
                             drive_stopped: dds.is_stopped(),
+                            sensor_failed: false,
+                            phase_error: RadPerSec::ZERO,
+                            ramping: false,
                             link_us: t,
                         };
                         let out = sup.check(t, &inp);
@@ -137,6 +140,9 @@ fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
         crank_speed: RadPerSec::from_num(crank),
         ref_omega: RadPerSec::from_num(ref_omega),
         drive_stopped: stopped,
+        sensor_failed: false,
+        phase_error: RadPerSec::ZERO,
+        ramping: false,
         link_us: 0,
     }
 }
@@ -234,6 +240,19 @@ fn drive_angle_slews_within_the_travel() {
     assert!((s.theta_d().to_deg() + 5.0).abs() < 1e-6);
 }
 
+/// 300 control ticks (1 ms apart, the link alive) on `inp` leave the rig running; the 301st
+/// halts it (the REFERENCE stall debounce: 300 ms).
+fn latches_after_300_ticks(s: &mut Supervisor, t: &mut u32, inp: &Inputs) {
+    for _ in 0..300 {
+        *t += 1000;
+        s.heard_from_link(*t);
+        check(s, *t, inp);
+        assert_eq!(s.mode(), Mode::Running, "t = {t}");
+    }
+    *t += 1000;
+    assert!(check(s, *t, inp).halt);
+}
+
 #[test]
 fn stall_and_over_current_stop_after_their_debounce() {
     let cfg = RigConfig::REFERENCE;
@@ -241,14 +260,7 @@ fn stall_and_over_current_stop_after_their_debounce() {
     s.request(Request::Start { omega: 300.0 }).unwrap();
     // Crank at 10 % of the reference: stall after 300 ms, not before.
     let mut t = 0;
-    for _ in 0..300 {
-        t += 1000;
-        s.heard_from_link(t);
-        check(&mut s, t, &quiet(100.0, 10.0, false));
-        assert_eq!(s.mode(), Mode::Running, "t = {t}");
-    }
-    t += 1000;
-    assert!(check(&mut s, t, &quiet(100.0, 10.0, false)).halt);
+    latches_after_300_ticks(&mut s, &mut t, &quiet(100.0, 10.0, false));
     assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
     s.request(Request::ClearFault).unwrap();
     s.request(Request::Start { omega: 300.0 }).unwrap();
@@ -263,4 +275,132 @@ fn stall_and_over_current_stop_after_their_debounce() {
     t += 1000;
     check(&mut s, t, &inp);
     assert_eq!(s.mode(), Mode::Faulted(Fault::OverCurrent));
+}
+
+#[test]
+fn a_crank_turning_backwards_faults_after_the_stall_debounce() {
+    // Swapped encoder channels or motor leads: the crank follows the drive at full speed, but
+    // backwards. |speed| is above the stall bar, so only the sign can catch it; the debounce is
+    // the stall's (REFERENCE: 300 ms at 1 kHz ticks, so 300 ticks pass and the 301st latches).
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut t = 0;
+    latches_after_300_ticks(&mut s, &mut t, &quiet(100.0, -100.0, false));
+    assert_eq!(s.mode(), Mode::Faulted(Fault::WrongDirection));
+    assert_eq!(
+        s.request(Request::Start { omega: 300.0 }),
+        Err(Refusal::Faulted(Fault::WrongDirection))
+    );
+    // Backwards but slower than the bar (30 % of 100 rad/s): a stall, not a wrong direction.
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    for _ in 0..301 {
+        t += 1000;
+        s.heard_from_link(t);
+        check(&mut s, t, &quiet(100.0, -20.0, false));
+    }
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Stall));
+    // Forwards at speed: neither.
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    for _ in 0..1000 {
+        t += 1000;
+        s.heard_from_link(t);
+        check(&mut s, t, &quiet(100.0, 100.0, false));
+    }
+    assert_eq!(s.mode(), Mode::Running);
+}
+
+#[test]
+fn a_failed_sensor_latches_in_any_mode_and_refuses_a_start() {
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    let mut inp = quiet(0.0, 0.0, true);
+    inp.sensor_failed = true;
+    assert!(check(&mut s, 1000, &inp).halt);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Sensor));
+    assert_eq!(
+        s.request(Request::Start { omega: 100.0 }),
+        Err(Refusal::Faulted(Fault::Sensor))
+    );
+    // Once the sensor is back, the fault clears and a start is taken.
+    check(&mut s, 2000, &quiet(0.0, 0.0, true));
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 100.0 }).unwrap();
+    assert_eq!(s.mode(), Mode::Running);
+    // While running: halted at once.
+    s.heard_from_link(3000);
+    let mut inp = quiet(50.0, 50.0, false);
+    inp.sensor_failed = true;
+    assert!(check(&mut s, 3000, &inp).halt);
+    assert_eq!(s.last_stop(), Some(StopReason::Fault(Fault::Sensor)));
+}
+
+#[test]
+fn the_i2t_limit_trips_when_the_closed_form_says() {
+    // A constant current I from rest: the exponential mean of i² is I²(1 − e^(−t/τ)), which
+    // reaches the limit (0.6·I_max)² at t = −τ ln(1 − (0.6·I_max/I)²). REFERENCE: I_max = 3 A,
+    // so the RMS limit is 1.8 A; at I = 2.5 A (below the 3 A peak trip) t = −ln(1 − 0.5184) s
+    // = 0.7306 s. The discrete mean at 1 kHz (weight h/τ = 1e-3 per tick) follows
+    // 1 − (1 − 1e-3)^n, which reaches 0.5184 at n = ln(0.4816)/ln(0.999) = 730.2 ticks: the
+    // trip tick is 731 (±1 for the Q16 rounding of 2.5 A, which is exact).
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    let mut inp = quiet(0.0, 0.0, true);
+    inp.current = Amps::from_num(2.5);
+    let mut tripped = None;
+    for k in 1..=2000u32 {
+        check(&mut s, k * 1000, &inp);
+        if s.mode() == Mode::Faulted(Fault::OverCurrentRms) {
+            tripped = Some(k);
+            break;
+        }
+    }
+    let k = tripped.expect("the I²t limit trips");
+    assert!((730..=732).contains(&k), "tripped at tick {k}");
+    // 1.7 A, below the RMS limit, never trips.
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    inp.current = Amps::from_num(1.7);
+    for k in 1..=10_000u32 {
+        check(&mut s, k * 1000, &inp);
+    }
+    assert_eq!(s.mode(), Mode::Idle);
+}
+
+#[test]
+fn two_cycle_slips_within_a_second_lose_the_phase_lock() {
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut t = 0u32;
+    let mut tick = |s: &mut Supervisor, e: f64| {
+        t += 1000;
+        s.heard_from_link(t);
+        let mut inp = quiet(100.0, 100.0, false);
+        inp.phase_error = RadPerSec::from_num(e);
+        check(s, t, &inp);
+    };
+    // Large errors that do not wrap are no slip.
+    for _ in 0..100 {
+        tick(&mut s, 3.0);
+        tick(&mut s, 1.0);
+    }
+    assert_eq!(s.mode(), Mode::Running);
+    // One slip (+3 → −3 rad: the wrap at π), then another 1.5 s later: still running.
+    tick(&mut s, 3.0);
+    tick(&mut s, -3.0);
+    for _ in 0..1500 {
+        tick(&mut s, 0.0);
+    }
+    tick(&mut s, -3.0);
+    tick(&mut s, 3.0);
+    assert_eq!(s.mode(), Mode::Running);
+    // A third slip 0.5 s after the second: lost.
+    for _ in 0..500 {
+        tick(&mut s, 0.0);
+    }
+    tick(&mut s, 3.0);
+    tick(&mut s, -3.0);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::PhaseLockLost));
 }

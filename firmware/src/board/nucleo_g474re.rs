@@ -9,37 +9,38 @@
 //! | H-bridge EN (PWM) | PA8 | TIM1_CH1, 20 kHz | DRV8874 in PH/EN mode; TIM1 is the drive timer |
 //! | H-bridge PH (direction) | PA9 | GPIO out | |
 //! | H-bridge nSLEEP | PA10 | GPIO out | low = bridge off (also at reset: board pull-down) |
+//! | H-bridge nFAULT | PA6 | TIM1_BKIN (AF6) | open drain, pulled up: low = fault, TIM1 break (outputs off in hardware) |
 //! | motor current (IPROPI) | PA0 | ADC1_IN1 | 1.5 kΩ to ground: 0.6825 V/A |
 //! | crank encoder A / B | PB6 / PB7 | TIM4_CH1/CH2, encoder mode | 2048 lines, 8192 counts per turn |
 //! | tilt servo | PB4 | TIM3_CH1, 50 Hz | 500–2500 µs over 270° |
-//! | pendulum encoder SCK / MISO / MOSI | PB13 / PB14 / PB15 | SPI2, mode 1, 5.3 MHz | AS5047P, 14 bit |
+//! | pendulum encoder SCK / MISO / MOSI | PB13 / PB14 / PB15 | SPI2, mode 1, 5.3 MHz | AS5047P, 14 bit; MISO pulled up (a cut cable reads 0xFFFF) |
 //! | pendulum encoder CSn | PB12 | GPIO out | |
-//! | emergency stop | PB1 | EXTI1, pull-up | normally-closed contact to GND: open = stop |
+//! | emergency stop | PB1 | GPIO in, pull-up (+ external 4.7 kΩ and RC) | normally-closed contact to GND: open = stop; read at every control tick |
 //! | laptop link TX / RX | PA2 / PA3 | USART2, 115200 8N1 | ST-LINK virtual COM port |
 //! | (time driver) | — | TIM2 | `time-driver-tim2` in Cargo.toml |
 //! | (control-loop executor) | — | UART4 interrupt | unused peripheral, its IRQ runs the executor |
 //! | (configuration record) | — | flash page 0x0807_F800 | last 2 KiB page of bank 2 |
 
 use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, AnyAdcChannel, SampleTime};
-use embassy_stm32::exti::{self, ExtiInput};
 use embassy_stm32::flash::{Blocking, Flash};
-use embassy_stm32::gpio::{Level, Output, OutputType, Pull, Speed};
+use embassy_stm32::gpio::{Input, Level, Output, OutputType, Pull, Speed};
 use embassy_stm32::interrupt::{self, InterruptExt, Priority};
-use embassy_stm32::peripherals::{ADC1, IWDG, TIM1, TIM3, TIM4};
+use embassy_stm32::pac::timer::vals::{Bkp, FilterValue, Ossi};
+use embassy_stm32::peripherals::{ADC1, IWDG, PA6, TIM1, TIM3, TIM4};
 use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::timer::qei::{self, Qei};
 use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm, SimplePwmChannel};
 use embassy_stm32::usart::{self, BufferedUart};
-use embassy_stm32::{bind_interrupts, peripherals, rcc, Config, Peri, Peripherals};
+use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config, Peri, Peripherals};
+use kapitza_core::rig::servo::ServoMap;
 use static_cell::StaticCell;
 
 pub const NAME: &str = "NUCLEO-G474RE";
 
 bind_interrupts!(struct Irqs {
     USART2 => usart::BufferedInterruptHandler<peripherals::USART2>;
-    EXTI1 => exti::InterruptHandler<interrupt::typelevel::EXTI1>;
 });
 
 /// The interrupt that runs the control loop's executor (UART4 is not used on this board), and
@@ -53,6 +54,10 @@ unsafe fn UART4() {
     // SAFETY: called only from this interrupt's handler, after `start` (main.rs).
     unsafe { crate::CONTROL_EXECUTOR.on_interrupt() }
 }
+
+/// Chip-select setup and hold around an AS5047P frame, and its high time between frames: the
+/// datasheet's tL, tH and tCSn are ≥ 350 ns ("SPI Timing"), 60 cycles at 170 MHz (352 ns).
+const CS_CYCLES: u32 = 60;
 
 /// SYSCLK = 170 MHz (the G474's maximum) from the internal 16 MHz HSI.
 ///
@@ -97,15 +102,19 @@ pub const PENDULUM_SIGN: i8 = 1;
 /// `persist.x` asserts that the program image stays below it.
 pub const CONFIG_PAGE_OFFSET: u32 = 0x7_F800;
 pub const CONFIG_PAGE_SIZE: u32 = 2048;
-/// Tilt servo: pulse width at the travel's two ends of its 270° range, and the angle θd (deg)
-/// the middle of the range points the drive at.
-pub const SERVO_MIN_US: u32 = 500;
-pub const SERVO_MAX_US: u32 = 2500;
-pub const SERVO_RANGE_DEG: f64 = 270.0;
-pub const SERVO_CENTRE_DEG: f64 = 90.0;
+/// Tilt servo: pulse width at the two ends of its 270° range, and the angle θd (deg) the middle
+/// of the range points the drive at.
+pub const SERVO_MAP: ServoMap = ServoMap {
+    min_us: 500,
+    max_us: 2500,
+    range_deg: 270.0,
+    centre_deg: 90.0,
+};
 
-/// The crank motor's hardware: H-bridge, encoder, current sense.
+/// The crank motor's hardware: H-bridge, encoder, current sense, and the e-stop line read at
+/// each control tick.
 pub struct Drive {
+    estop: Input<'static>,
     en: SimplePwmChannel<'static, TIM1>,
     phase: Output<'static>,
     sleep: Output<'static>,
@@ -132,6 +141,10 @@ impl Drive {
     pub fn crank_count(&self) -> u32 {
         u32::from(self.encoder.count()) % CRANK_COUNTS
     }
+    /// The e-stop is active: the normally-closed contact is open (pressed) or its wire is cut.
+    pub fn estop_active(&self) -> bool {
+        self.estop.is_high()
+    }
     /// One conversion of the current sense (12-bit counts).
     pub fn current_counts(&mut self) -> u16 {
         self.adc
@@ -145,12 +158,13 @@ pub struct Tilt {
 }
 
 impl Tilt {
-    /// Servo pulse width in µs (clamped to the servo's range).
+    /// Servo pulse width in µs (clamped to the servo's range); the first call starts the pulses.
     pub fn set_pulse_us(&mut self, us: u32) {
-        let us = us.clamp(SERVO_MIN_US, SERVO_MAX_US);
+        let us = us.clamp(SERVO_MAP.min_us, SERVO_MAP.max_us);
         // 50 Hz: 20 000 µs per period.
         let max = self.pwm.max_duty_cycle();
         self.pwm.set_duty_cycle(us * max / 20_000);
+        self.pwm.enable();
     }
 }
 
@@ -161,27 +175,45 @@ pub struct PendulumBus {
 }
 
 impl PendulumBus {
-    /// One 16-bit SPI frame, chip-select around it.
+    /// One 16-bit SPI frame, chip-select around it with the sensor's setup, hold and
+    /// high times.
     pub fn transfer(&mut self, word: u16) -> Result<u16, spi::Error> {
         let mut w = [word];
         self.cs.set_low();
+        cortex_m::asm::delay(CS_CYCLES);
         let r = self.spi.blocking_transfer_in_place(&mut w);
+        cortex_m::asm::delay(CS_CYCLES);
         self.cs.set_high();
+        cortex_m::asm::delay(CS_CYCLES);
         r.map(|()| w[0])
     }
 }
 
-/// The safety task's inputs: the e-stop line and the independent watchdog.
-pub struct SafetyIo {
-    pub estop: ExtiInput<'static, embassy_stm32::mode::Async>,
-    pub iwdg: Peri<'static, IWDG>,
+/// TIM1's break input on PA6 (AF6), wired to the DRV8874's nFAULT: a bridge fault (over-current,
+/// over-temperature, under-voltage) clears MOE in hardware within a few clock cycles, forcing the
+/// PWM pin to its idle level (low) whatever the software does. Active low, filtered over 8 clock
+/// samples (47 ns) against glitches; no automatic re-enable (AOE = 0): only a reset re-arms the
+/// drive. The pin is taken from `Peripherals` so nothing else can claim it.
+fn arm_break_input(_nfault: Peri<'static, PA6>) {
+    let pa = pac::GPIOA;
+    pa.pupdr()
+        .modify(|w| w.set_pupdr(6, pac::gpio::vals::Pupdr::PULL_UP));
+    pa.afr(0).modify(|w| w.set_afr(6, 6));
+    pa.moder()
+        .modify(|w| w.set_moder(6, pac::gpio::vals::Moder::ALTERNATE));
+    pac::TIM1.af1().modify(|w| w.set_bkine(true));
+    pac::TIM1.bdtr().modify(|w| {
+        w.set_ossi(Ossi::IDLE_LEVEL);
+        w.set_bkf(0, FilterValue::FCK_INT_N8);
+        w.set_bkp(0, Bkp::ACTIVE_LOW);
+        w.set_aoe(false);
+        w.set_bke(0, true);
+    });
 }
 
-impl SafetyIo {
-    /// The e-stop is active: the normally-closed contact is open (pressed) or its wire is cut.
-    pub fn estop_active(&self) -> bool {
-        self.estop.is_high()
-    }
+/// The watchdog, for the safety task.
+pub struct SafetyIo {
+    pub iwdg: Peri<'static, IWDG>,
 }
 
 /// Every task's share of the chip.
@@ -210,12 +242,14 @@ pub fn split(p: Peripherals) -> Board {
     let mut en = pwm.split().ch1;
     en.set_duty_cycle(0);
     en.enable();
+    arm_break_input(p.PA6);
     let qcfg = qei::Config {
         auto_reload: (CRANK_COUNTS - 1) as u16,
         ..Default::default()
     };
     let encoder = Qei::new(p.TIM4, p.PB6, p.PB7, qcfg);
     let drive = Drive {
+        estop: Input::new(p.PB1, Pull::Up),
         en,
         phase: Output::new(p.PA9, Level::Low, Speed::Low),
         sleep: Output::new(p.PA10, Level::Low, Speed::Low),
@@ -224,7 +258,8 @@ pub fn split(p: Peripherals) -> Board {
         sense: p.PA0.degrade_adc(),
     };
 
-    // Tilt servo: TIM3 CH1 at 50 Hz, centred.
+    // Tilt servo: TIM3 CH1 at 50 Hz, no pulses until the control loop names its first θd (a
+    // pulse now would swing the mount: `kapitza_core::rig::servo`).
     let servo_pin = PwmPin::new(p.PB4, OutputType::PushPull);
     let pwm = SimplePwm::new(
         p.TIM3,
@@ -235,24 +270,21 @@ pub fn split(p: Peripherals) -> Board {
         Hertz(50),
         CountingMode::EdgeAlignedUp,
     );
-    let mut ch = pwm.split().ch1;
-    ch.enable();
-    let mut tilt = Tilt { pwm: ch };
-    tilt.set_pulse_us((SERVO_MIN_US + SERVO_MAX_US) / 2);
+    let tilt = Tilt {
+        pwm: pwm.split().ch1,
+    };
 
     // Pendulum encoder: AS5047P, SPI mode 1 (CPOL 0, CPHA 1), at most 10 MHz.
     let mut scfg = spi::Config::default();
     scfg.mode = spi::MODE_1;
     scfg.frequency = Hertz(5_000_000);
+    scfg.miso_pull = Pull::Up;
     let pendulum = PendulumBus {
         spi: Spi::new_blocking(p.SPI2, p.PB13, p.PB15, p.PB14, scfg),
         cs: Output::new(p.PB12, Level::High, Speed::VeryHigh),
     };
 
-    let safety = SafetyIo {
-        estop: ExtiInput::new(p.PB1, p.EXTI1, Pull::Up, Irqs),
-        iwdg: p.IWDG,
-    };
+    let safety = SafetyIo { iwdg: p.IWDG };
 
     // Laptop link on the ST-LINK's virtual COM port.
     static TX_BUF: StaticCell<[u8; 512]> = StaticCell::new();

@@ -7,25 +7,30 @@
 //! ```text
 //! every sample (from the pendulum task):  loop.sample
 //! when it says a control tick is due:     bytes from the link task → loop.receive (answered now)
-//!                                         loop.control(crank, current, e-stop) → duty
+//!                                         loop.control(crank, current, e-stop pin) → duty
 //!                                         bridge enable, θd to the servo, a configuration to
-//!                                         store, heartbeat to the watchdog
+//!                                         store, heartbeat to the watchdog, θd and the last
+//!                                         fault to the retained RAM
 //!                                         loop.transmit → frame bytes to the link task
 //! ```
 //! The loop is clocked by the samples, so the DDS advances exactly once per sample and the
 //! estimator sees each sample with the drive phase of the same tick.
 
+use kapitza_core::link::message::ResetInfo;
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::{Amps, Angle, Duty};
 use kapitza_core::rig::phase_lock::Motor;
+use kapitza_core::rig::retained::Retained;
+use kapitza_core::rig::safety::Mode;
 use kapitza_core::station::RigLoop;
 
 use crate::board::{Drive, AMPS_PER_COUNT_Q16, CRANK_COUNTS};
 use crate::channels::{
-    CONFIG_SAVED, ESTOP, FROM_LAPTOP, HEARTBEAT, LINE_ERROR, SAMPLES, SAMPLE_HZ, SAVE_CONFIG,
-    THETA_D, TO_LAPTOP,
+    CONFIG_SAVED, FROM_LAPTOP, HEARTBEAT, LINE_ERROR, SAMPLES, SAMPLE_HZ, SAVE_CONFIG, THETA_D,
+    TO_LAPTOP,
 };
+use crate::retained;
 
 /// This firmware's version, from its Cargo.toml.
 const FIRMWARE: [u16; 3] = [
@@ -64,16 +69,25 @@ impl Motor for Hw<'_> {
     }
 }
 
+/// `theta_d0`: where the servo starts (`kapitza_core::rig::servo::power_up_deg`); `kept`: what
+/// the firmware left before the last reset; `reset`: its cause and last fault, for the status.
 #[embassy_executor::task]
-pub async fn run(mut drive: Drive, cfg: RigConfig, origin: ConfigOrigin) {
-    // The servo's position at power-up is unknown (it is open loop): command θd = 0 (vertical
-    // shaking), or the nearest end of the travel if 0 is outside it, while the drive is idle.
-    let theta0_deg = 0f64.clamp(
-        cfg.limits.drive_angle_min_deg,
-        cfg.limits.drive_angle_max_deg,
-    );
+pub async fn run(
+    mut drive: Drive,
+    cfg: RigConfig,
+    origin: ConfigOrigin,
+    theta_d0: f64,
+    kept: Option<Retained>,
+    reset: ResetInfo,
+) {
     let t0 = embassy_time::Instant::now().as_micros() as u32;
-    let mut rig = RigLoop::new(cfg, origin, Angle::from_deg(theta0_deg), t0, FIRMWARE);
+    let mut rig =
+        RigLoop::new(cfg, origin, Angle::from_deg(theta_d0), t0, FIRMWARE).after_reset(reset);
+    let mut keep = Retained {
+        theta_d_deg: theta_d0 as f32,
+        last_fault: kept.and_then(|k| k.last_fault),
+    };
+    retained::store(&keep);
     let mut inbox = [0u8; 64];
     let mut outbox = [0u8; 128];
     drive.enable(false);
@@ -92,10 +106,19 @@ pub async fn run(mut drive: Drive, cfg: RigConfig, origin: ConfigOrigin) {
         if let Some(ok) = CONFIG_SAVED.try_take() {
             rig.config_saved(ok);
         }
-        let tick = rig.control(t, &mut Hw { drive: &mut drive }, ESTOP.try_get());
+        let estop = drive.estop_active();
+        let tick = rig.control(t, &mut Hw { drive: &mut drive }, Some(estop));
         drive.enable(tick.bridge);
+        let before = keep;
         if let Some(deg) = tick.servo_deg {
             THETA_D.signal(deg);
+            keep.theta_d_deg = deg as f32;
+        }
+        if let Mode::Faulted(f) = tick.report.mode {
+            keep.last_fault = Some(f);
+        }
+        if keep != before {
+            retained::store(&keep);
         }
         if let Some(new) = tick.store {
             SAMPLE_HZ.sender().send(new.sample_hz);

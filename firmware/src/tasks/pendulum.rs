@@ -1,41 +1,18 @@
-//! The pendulum sensor: an AS5047P magnetic absolute encoder on SPI, read at the sample rate.
+//! The pendulum sensor: an AS5047P on SPI, read at the sample rate.
 //!
-//! ```text
-//! command ANGLECOM (0x3FFF), read:  0xFFFF   (bit 15 even parity, bit 14 read)
-//! answer (to the previous command): bit 15 even parity over all 16 bits, bit 14 error flag,
-//!                                   bits 13..0 the angle, 2^14 counts per turn
-//! θ = sign · (count − zero) · 2^18    (Angle: 2^32 per turn)
-//! ```
-//! Reading ANGLECOM continuously makes every frame both the next command and the previous
-//! answer, so one 16-bit transfer per sample. A failed read repeats the last good angle and is
-//! flagged in the sample (counted in the status).
+//! The frames, the error flag and its clearing read, the diagnostics, the sensor's health and
+//! the count → angle map are `kapitza_core::rig::as5047`; this task keeps the sample clock and
+//! moves the words. Missed sample times are skipped, never caught up in a burst
+//! (`kapitza_core::station::next_due`), and the sample after a skip is marked late (an overrun
+//! in the status). Each sample carries the time its angle was latched (the frame before).
 
-use defmt::warn;
-use embassy_time::{Duration, Instant, Ticker};
+use embassy_time::{Duration, Instant, Timer};
+use kapitza_core::rig::as5047::{self, As5047};
 use kapitza_core::rig::fixed::Angle;
+use kapitza_core::station::{next_due, Sample};
 
 use crate::board::{PendulumBus, PENDULUM_SIGN, PENDULUM_ZERO};
-use kapitza_core::station::Sample;
-
 use crate::channels::{SAMPLES, SAMPLE_HZ};
-
-/// Read ANGLECOM (0x3FFF) with the read bit and even parity.
-const READ_ANGLE: u16 = 0xFFFF;
-
-/// The angle count of an answer frame, if its parity is even and its error flag clear.
-fn decode(word: u16) -> Option<u16> {
-    (word.count_ones().is_multiple_of(2) && word & 0x4000 == 0).then_some(word & 0x3FFF)
-}
-
-fn angle_of(count: u16) -> Angle {
-    let off = u32::from(count.wrapping_sub(PENDULUM_ZERO) & 0x3FFF) << 18;
-    let a = Angle::from_turns_u32(off);
-    if PENDULUM_SIGN < 0 {
-        Angle::ZERO - a
-    } else {
-        a
-    }
-}
 
 fn period(hz: u32) -> Duration {
     Duration::from_hz(u64::from(hz.max(1)))
@@ -44,34 +21,38 @@ fn period(hz: u32) -> Duration {
 #[embassy_executor::task]
 pub async fn run(mut bus: PendulumBus, sample_hz: u32) {
     let mut hz = defmt::unwrap!(SAMPLE_HZ.receiver());
-    let mut dt = period(sample_hz);
-    let mut ticker = Ticker::every(dt);
-    let mut last = Angle::ZERO;
-    let mut prev = Instant::now();
+    let mut dt = period(sample_hz).as_ticks();
+    let mut sensor = As5047::new();
+    let mut held = Angle::ZERO;
+    let mut late = false;
+    // The sensor answers 10 ms after its supply comes up (AS5047P datasheet, "power-up time"
+    // tPwrUp); frames before that would count towards a sensor fault at every boot.
+    Timer::after_millis(10).await;
     // Prime the pipeline: the first answer belongs to no command of ours.
-    let _ = bus.transfer(READ_ANGLE);
+    let t0 = Instant::now();
+    sensor.sample(t0.as_micros() as u32, |w| bus.transfer(w));
+    let mut due = t0.as_ticks();
     loop {
-        ticker.next().await;
+        let (next, skipped) = next_due(due, Instant::now().as_ticks(), dt);
+        due = next;
+        late |= skipped > 0;
+        Timer::at(Instant::from_ticks(due)).await;
         if let Some(new) = hz.try_changed() {
-            dt = period(new);
-            ticker = Ticker::every(dt);
+            dt = period(new).as_ticks();
         }
-        let now = Instant::now();
-        let late = now.duration_since(prev) > dt + dt / 2;
-        prev = now;
-        let read = bus.transfer(READ_ANGLE).ok().and_then(decode);
-        if let Some(c) = read {
-            last = angle_of(c);
+        let read = sensor.sample(Instant::now().as_micros() as u32, |w| bus.transfer(w));
+        if let Ok(count) = read.count {
+            held = as5047::angle(count, PENDULUM_ZERO, PENDULUM_SIGN);
         }
         let s = Sample {
-            t_us: now.as_micros() as u32,
-            angle: last,
-            failed: read.is_none(),
+            t_us: read.t_us,
+            angle: held,
+            failed: read.count.is_err(),
             late,
+            sensor_failed: sensor.health().failed(),
         };
-        if SAMPLES.try_send(s).is_err() {
-            // The control loop is behind by a whole queue: it will see `late` samples.
-            warn!("pendulum: sample queue full");
-        }
+        // A full queue means the control loop is behind: the sample is lost and the next one
+        // says so (no log line here: this runs 10 000 times a second).
+        late = SAMPLES.try_send(s).is_err();
     }
 }

@@ -8,6 +8,8 @@
 //! back; bank 2 is erased while the program runs from bank 1 (read-while-write), so the control
 //! loop keeps running; the link task waits (≈ 25 ms) with its bytes in the UART buffer.
 
+use core::sync::atomic::Ordering;
+
 use defmt::{info, warn};
 use embassy_stm32::flash::{Blocking, Flash};
 use kapitza_core::persist::{self, ConfigOrigin, RECORD_MAX};
@@ -15,12 +17,26 @@ use kapitza_core::rig::config::RigConfig;
 
 use crate::board::{CONFIG_PAGE_OFFSET, CONFIG_PAGE_SIZE};
 use crate::channels::{CONFIG_SAVED, SAVE_CONFIG};
+use crate::fail_safe::{ECC_ERROR, READING_CONFIG};
 
 /// The configuration to start with, and where it came from (never fails: see
 /// `kapitza_core::persist::load`).
+///
+/// A double ECC error in the page (a power loss mid-write) raises an NMI, which
+/// `fail_safe::NonMaskableInt` clears while this read runs: the record then counts as corrupt.
 pub fn load(flash: &mut Flash<'static, Blocking>) -> (RigConfig, ConfigOrigin) {
     let mut buf = [0u8; RECORD_MAX];
-    match flash.blocking_read(CONFIG_PAGE_OFFSET, &mut buf) {
+    READING_CONFIG.store(true, Ordering::SeqCst);
+    let read = flash.blocking_read(CONFIG_PAGE_OFFSET, &mut buf);
+    READING_CONFIG.store(false, Ordering::SeqCst);
+    if ECC_ERROR.load(Ordering::SeqCst) {
+        warn!("persist: double ECC error in the configuration page (power lost mid-write?)");
+        return (
+            RigConfig::REFERENCE,
+            ConfigOrigin::Defaults(persist::Fallback::Corrupt),
+        );
+    }
+    match read {
         Ok(()) => persist::load(&buf),
         Err(e) => {
             warn!("persist: flash read failed: {}", e);

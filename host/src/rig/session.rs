@@ -12,7 +12,7 @@ use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
 use serde::Serialize;
 
-use super::names::{fault_name, mode_name, stop_name, turns_deg};
+use super::names::{fault_name, mode_name, reset_name, stop_name, turns_deg};
 use super::owner;
 use super::port::{self, ReadWrite, Target};
 use super::predicted::{predict, Prediction};
@@ -167,6 +167,10 @@ pub struct StatusView {
     /// Where the rig's configuration came from.
     pub config: String,
     pub uptime_s: f64,
+    /// Why the rig last reset (`"power_on"`, `"pin"`, `"watchdog"`, `"software"`, `"other"`),
+    /// and the fault latched before that reset, or null.
+    pub reset_cause: &'static str,
+    pub fault_before_reset: Option<&'static str>,
     pub frames_ok: u32,
     pub frames_bad: u32,
     pub frames_dropped: u32,
@@ -213,6 +217,8 @@ impl StatusView {
                 ConfigOrigin::Defaults(f) => format!("safe defaults ({f:?})"),
             },
             uptime_s: f64::from(s.uptime_ms) / 1000.0,
+            reset_cause: reset_name(&s.reset.cause),
+            fault_before_reset: s.reset.last_fault.as_ref().map(fault_name),
             frames_ok: s.counters.frames_ok,
             frames_bad: s.counters.frames_bad,
             frames_dropped: s.counters.frames_dropped,
@@ -256,6 +262,15 @@ impl StatusView {
             s += &format!(
                 "\n            R in situ = {r:.3} (requested {:.3})",
                 self.r_target
+            );
+        }
+        if self.reset_cause != "power_on" {
+            s += &format!(
+                "\nreset       last reset: {}{}",
+                self.reset_cause,
+                self.fault_before_reset
+                    .map(|f| format!(" after the fault {f}"))
+                    .unwrap_or_default()
             );
         }
         s += &format!(

@@ -37,6 +37,10 @@ impl From<safety::Fault> for Fault {
             safety::Fault::EStop => Self::EStop,
             safety::Fault::OverCurrent => Self::OverCurrent,
             safety::Fault::Stall => Self::Stall,
+            safety::Fault::Sensor => Self::Sensor,
+            safety::Fault::WrongDirection => Self::WrongDirection,
+            safety::Fault::PhaseLockLost => Self::PhaseLockLost,
+            safety::Fault::OverCurrentRms => Self::OverCurrentRms,
         }
     }
 }

@@ -119,6 +119,41 @@ pub struct Status {
     /// Milliseconds since power-up (wraps after 49.7 days).
     pub uptime_ms: u32,
     pub counters: Counters,
+    /// Why the rig last reset, and the fault latched before it.
+    pub reset: ResetInfo,
+}
+
+/// Why the rig last reset (the chip's reset flags), and the last fault latched before it (kept
+/// in RAM across the reset: [`crate::rig::retained`]), so a watchdog reset mid-demo is seen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ResetInfo {
+    pub cause: ResetCause,
+    pub last_fault: Option<Fault>,
+}
+
+/// The cause of the last reset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResetCause {
+    /// Power-on or brown-out: nothing survived.
+    PowerOn,
+    /// The reset pin (the board's button, or the probe).
+    Pin,
+    /// The independent watchdog: the control loop stopped ticking.
+    Watchdog,
+    /// A software reset.
+    Software,
+    /// Another cause (low-power, option-byte load, window watchdog).
+    Other,
+}
+
+impl ResetInfo {
+    /// A cold start: nothing before it.
+    pub const POWER_ON: Self = Self {
+        cause: ResetCause::PowerOn,
+        last_fault: None,
+    };
 }
 
 /// Event counters since power-up (saturating).
@@ -207,6 +242,10 @@ pub enum Fault {
     EStop,
     OverCurrent,
     Stall,
+    Sensor,
+    WrongDirection,
+    PhaseLockLost,
+    OverCurrentRms,
 }
 
 /// [`crate::model::RMethod`].

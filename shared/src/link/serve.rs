@@ -3,7 +3,9 @@
 //! request. [`crate::station::RigLoop`] owns one and frames its answers.
 
 use super::convert::{deg_along_travel, from_q16, to_q16};
-use super::message::{Counters, Request, Response, Status, Telemetry, VersionInfo, WireConfig};
+use super::message::{
+    Counters, Request, ResetInfo, Response, Status, Telemetry, VersionInfo, WireConfig,
+};
 use super::reason::Reason;
 use crate::persist::ConfigOrigin;
 use crate::rig::config::RigConfig;
@@ -94,6 +96,7 @@ pub fn status(
     config: ConfigOrigin,
     uptime_ms: u32,
     counters: Counters,
+    reset: ResetInfo,
 ) -> Status {
     let sup = rig.supervisor();
     let min = cfg.limits.drive_angle_min_deg;
@@ -108,6 +111,7 @@ pub fn status(
         config,
         uptime_ms,
         counters,
+        reset,
     }
 }
 
@@ -163,6 +167,8 @@ pub struct RigServer {
     /// The protocol version reported by `GetVersion`: [`super::PROTOCOL_VERSION`] unless a
     /// simulated rig is made to speak another one.
     pub protocol: u8,
+    /// Why the rig last reset (reported in the status).
+    pub reset: ResetInfo,
 }
 
 impl RigServer {
@@ -185,6 +191,7 @@ impl RigServer {
             tuning,
             firmware,
             protocol: super::PROTOCOL_VERSION,
+            reset: ResetInfo::POWER_ON,
         }
     }
 
@@ -208,6 +215,7 @@ impl RigServer {
                     self.origin,
                     at.uptime_ms,
                     self.counters,
+                    self.reset,
                 )),
                 Effect::None,
             ),

@@ -204,12 +204,12 @@ impl RigConfig {
         q16("max_correction", self.motor.max_correction)?;
         if self.control_hz == 0
             || !self.sample_hz.is_multiple_of(self.control_hz)
-            || self.sample_hz > 100_000
+            || !(MIN_SAMPLE_HZ..=MAX_SAMPLE_HZ).contains(&self.sample_hz)
         {
             return Err(too_big(
                 "sample_hz",
                 f64::from(self.sample_hz),
-                "a multiple of control_hz, at most 100 kHz",
+                "a multiple of control_hz, from 1 kHz to 12 kHz (the firmware's sample budget)",
             ));
         }
         Ok(self)
@@ -249,6 +249,17 @@ impl RigConfig {
 
 /// The end of the I16F16 range (RadPerSec, Amps, Ratio).
 const Q16_MAX: f64 = 32_768.0;
+
+/// The fastest sample rate the firmware keeps up with. Its worst sample must end before the
+/// next one starts (docs/accuracy-mcu.md, "The budget", at CPI 2.0): the estimator's slow
+/// update at the end of a drive period (≈ 48 µs), up to three sensor frames with their
+/// chip-select times (≈ 3 × 4 µs, `rig::as5047`), the control tick (≈ 5.4 µs) and the time
+/// driver's interrupt (≈ 1 µs): ≈ 66 µs, so 1/fs ≥ 66 µs, fs ≤ 15 kHz; 12 kHz keeps a fifth
+/// in reserve. A configuration above it would be stored and then overrun at every boot.
+pub const MAX_SAMPLE_HZ: u32 = 12_000;
+/// The slowest: at 1 kHz the sample is the control tick, and a 67 Hz drive period still has
+/// 15 samples for the synchronous average.
+pub const MIN_SAMPLE_HZ: u32 = 1_000;
 
 /// A positive number that I16F16 holds without saturating to its end or rounding to 0.
 fn q16(name: &'static str, value: f64) -> Result<f64, ParamError> {
@@ -293,6 +304,17 @@ mod tests {
         let mut c = RigConfig::REFERENCE;
         c.sample_hz = 10_001;
         assert_eq!(c.validate().unwrap_err().name, "sample_hz");
+        // Multiples of control_hz (1 kHz) on either side of the range [1 kHz, 12 kHz].
+        for (hz, ok) in [
+            (100_000, false),
+            (13_000, false),
+            (12_000, true),
+            (1_000, true),
+        ] {
+            let mut c = RigConfig::REFERENCE;
+            c.sample_hz = hz;
+            assert_eq!(c.validate().is_ok(), ok, "{hz}");
+        }
         let mut c = RigConfig::REFERENCE;
         c.limits.drive_angle_min_deg = 200.0;
         assert_eq!(c.validate().unwrap_err().name, "drive_angle_max_deg");

@@ -38,6 +38,8 @@ pub struct Rig {
     lock: PhaseLock,
     est: Estimator,
     sup: Supervisor,
+    sensor_failed: bool,
+    phase_error: RadPerSec,
 }
 
 impl Rig {
@@ -49,6 +51,8 @@ impl Rig {
             lock: PhaseLock::new(cfg),
             est: Estimator::new(cfg, tuning, theta_d0),
             sup: Supervisor::new(cfg, theta_d0, now_us),
+            sensor_failed: false,
+            phase_error: RadPerSec::ZERO,
         }
     }
 
@@ -61,6 +65,12 @@ impl Rig {
     /// A command; refused ones change nothing.
     pub fn request(&mut self, req: Request) -> Result<(), Refusal> {
         self.sup.request(req)
+    }
+
+    /// The pendulum sensor's driver says it has failed (or recovered); the next control tick
+    /// latches [`super::safety::Fault::Sensor`] while it is failed.
+    pub fn sensor_failed(&mut self, failed: bool) {
+        self.sensor_failed = failed;
     }
 
     /// Sample tick: advance the reference phase and feed the estimator. Returns the phase.
@@ -91,6 +101,9 @@ impl Rig {
             crank_speed: self.lock.crank_speed(),
             ref_omega: self.dds.omega(),
             drive_stopped: self.dds.is_stopped(),
+            sensor_failed: self.sensor_failed,
+            phase_error: self.phase_error,
+            ramping: self.dds.is_ramping(),
             link_us,
         };
         let out = self.sup.check(t_us, &inputs);
@@ -110,6 +123,7 @@ impl Rig {
             crank,
         );
         motor.set_duty(lock.duty);
+        self.phase_error = lock.error;
         let steady = run
             && !self.dds.is_ramping()
             && self.dds.word() > 0

@@ -12,8 +12,12 @@
 //! | [`dds`] | the drive-phase accumulator: exact integer phase, rate-limited phase-continuous frequency changes, soft start and stop |
 //! | [`phase_lock`] | the [`phase_lock::Motor`] trait and the crank phase-lock controller (feed-forward + PI on the phase error) |
 //! | [`estimator`] | slow angle by synchronous averaging, slow frequency and decay, settled flag, R in situ, fast-wobble check of A |
+//! | [`as5047`] | the pendulum sensor's SPI frames: parity, the error flag and its clearing read, diagnostics (magnet), health |
+//! | [`estop`] | the e-stop line debounced at the control tick; unknown counts as pressed |
 //! | [`safety`] | limits, refusals with reasons, stall / over-current / e-stop faults, the link-silence policy |
 //! | [`controller`] | one rig: the above composed into a sample tick and a control tick |
+//! | [`servo`] | θd → the tilt servo's pulse; the θd the rig starts from after a reset |
+//! | [`retained`] | the last θd and fault, kept in RAM across a reset with a CRC |
 //! | [`selftest`] | deterministic scenarios with digests, run on the host and on the emulated MCU |
 //!
 //! # Rates (why these)
@@ -27,11 +31,15 @@
 //! ```
 //! Costs per update and the 20 % budget at 170 MHz are measured in `docs/accuracy-mcu.md`.
 
+pub mod as5047;
 pub mod config;
 pub mod controller;
 pub mod dds;
 pub mod estimator;
+pub mod estop;
 pub mod fixed;
 pub mod phase_lock;
+pub mod retained;
 pub mod safety;
 pub mod selftest;
+pub mod servo;

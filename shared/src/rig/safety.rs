@@ -11,15 +11,20 @@
 //!   Idle ───────────────────────▶ Running ───────────────────────────────▶ Stopping ─▶ Idle
 //!    ▲                               │  SetOmega (ramped), SetDriveAngle (slewed)      (when the
 //!    │ ClearFault (e-stop released)  │                                                  drive is 0)
-//!    └──────────── Faulted ◀─────────┴── e-stop, over-current, stall (from any state): drive
-//!                                        halted at once, duty 0, latched
+//!    └──────────── Faulted ◀─────────┴── e-stop, over-current (peak, RMS), stall, wrong direction,
+//!                                        sensor, phase lock lost (from any state): drive halted
+//!                                        at once, duty 0, latched
 //! ```
 //! A drive strength R from the laptop becomes ω = ωc√R through [`RigConfig::omega_for_r`]
 //! before it reaches the supervisor (SPEC §7: "setting R means computing ω from R, A and ℓ").
 //! Limits: ω ≤ ω_max (refused above); |dω/dt| ≤ the ramp rate (the drive generator's step, not
 //! a request); |dθd/dt| ≤ its limit (slewed here); θd inside the mount's travel (refused
 //! outside). Over-current: I > I_max for `overcurrent_ms`. Stall: commanded ω ≥ `stall_min_omega`
-//! and crank speed < `stall_fraction`·commanded for `stall_ms`.
+//! and crank speed < `stall_fraction`·commanded for `stall_ms`. Wrong direction: the same
+//! commanded speed while the crank turns backwards faster than `stall_fraction`·commanded for
+//! `stall_ms`. Sensor: the pendulum sensor's driver reports it failed. Phase lock lost: two
+//! cycle slips within [`SLIP_WINDOW_US`]. Over-current RMS (I²t): the exponential mean of i²
+//! over [`RMS_TAU_S`] above ([`RMS_FRACTION`]·I_max)².
 //!
 //! # When the laptop link goes silent
 //!
@@ -103,11 +108,34 @@ impl core::fmt::Display for Refusal {
 
 /// A latched fault: the drive is halted until [`Request::ClearFault`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Fault {
     EStop,
     OverCurrent,
     Stall,
+    /// The pendulum sensor gave no good angle for too long, or reports its magnet out of range
+    /// ([`super::as5047::Health::failed`]).
+    Sensor,
+    /// The crank turns against the drive: swapped encoder channels or motor leads. The phase
+    /// lock would push it to full duty; caught like a stall, by sign.
+    WrongDirection,
+    /// The crank slipped a whole cycle behind or ahead of the drive twice within
+    /// [`SLIP_WINDOW_US`] while ω is steady: the phase lock cannot hold it (a motor too weak for the set ω, a
+    /// slipping belt). The crank may still turn fast enough not to count as a stall.
+    PhaseLockLost,
+    /// The motor current's RMS over the last [`RMS_TAU_S`] is above [`RMS_FRACTION`] of
+    /// `current_max`: an I²t limit for the winding and the bridge's continuous rating, below
+    /// the peak trip.
+    OverCurrentRms,
 }
+
+/// Two cycle slips within this long lose the lock (µs).
+pub const SLIP_WINDOW_US: u32 = 1_000_000;
+/// The I²t limit's time constant (s): the mean of i² is an exponential average over it.
+pub const RMS_TAU_S: f32 = 1.0;
+/// The RMS limit as a fraction of the peak limit `current_max`: the DRV8874 carrier's
+/// continuous ≈ 2 A against its peak-trip setting of 3 A (docs/hardware.md, "Parts").
+pub const RMS_FRACTION: f32 = 0.6;
 
 /// Why the drive last stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -135,6 +163,13 @@ pub struct Inputs {
     pub ref_omega: RadPerSec,
     /// The drive generator has reached zero frequency.
     pub drive_stopped: bool,
+    /// The pendulum sensor has failed ([`super::as5047::Health::failed`]).
+    pub sensor_failed: bool,
+    /// The phase lock's error φ_ref − φ_crank (rad, in (−π, π]) at the previous tick.
+    pub phase_error: RadPerSec,
+    /// The drive generator is ramping ω: the crank's lag behind the feed-forward may slip
+    /// cycles then without the lock being lost (the stall check watches that phase).
+    pub ramping: bool,
     /// The link's clock now (µs, wrapping), the clock [`Supervisor::heard_from_link`] is given.
     /// On the rig it is `now_us`; a simulated rig running faster than real time gives wall time,
     /// so the link-silence timeout stays what it says.
@@ -165,6 +200,13 @@ pub struct Supervisor {
     last_link_us: u32,
     over_since: Option<u32>,
     stall_since: Option<u32>,
+    reverse_since: Option<u32>,
+    last_phase_error: RadPerSec,
+    last_slip_us: Option<u32>,
+    /// Exponential mean of i² (A²) and its per-tick weight h/τ.
+    i2_mean: f32,
+    i2_weight: f32,
+    i2_max: f32,
     estop_seen: bool,
     // limits, fixed at construction
     omega_max: f64,
@@ -196,6 +238,15 @@ impl Supervisor {
             last_link_us: now_us,
             over_since: None,
             stall_since: None,
+            reverse_since: None,
+            last_phase_error: RadPerSec::ZERO,
+            last_slip_us: None,
+            i2_mean: 0.0,
+            i2_weight: 1.0 / (RMS_TAU_S * cfg.control_hz.max(1) as f32),
+            i2_max: {
+                let i = RMS_FRACTION * l.current_max as f32;
+                i * i
+            },
             estop_seen: false,
             omega_max: l.omega_max,
             theta_min_deg: l.drive_angle_min_deg,
@@ -264,6 +315,8 @@ impl Supervisor {
                 self.mode = Mode::Running;
                 self.target_word = w;
                 self.stall_since = None;
+                self.reverse_since = None;
+                self.last_slip_us = None;
             }
             Request::SetOmega { omega } => {
                 let w = self.check_omega(omega)?;
@@ -296,6 +349,7 @@ impl Supervisor {
                     self.mode = Mode::Idle;
                     self.over_since = None;
                     self.stall_since = None;
+                    self.reverse_since = None;
                 }
             }
         }
@@ -327,19 +381,49 @@ impl Supervisor {
         } else {
             self.over_since = None;
         }
-        // Stall: driving hard but the crank does not follow.
+        if inp.sensor_failed && !matches!(self.mode, Mode::Faulted(_)) {
+            self.fault(Fault::Sensor);
+        }
+        // I²t: the exponential mean of i² against the RMS limit squared.
+        let i = inp.current.to_num::<f32>();
+        self.i2_mean += (i * i - self.i2_mean) * self.i2_weight;
+        if self.i2_mean > self.i2_max && !matches!(self.mode, Mode::Faulted(_)) {
+            self.fault(Fault::OverCurrentRms);
+        }
+        // Stall: driving hard but the crank does not follow. Wrong direction: it follows
+        // backwards (the drive reference is never negative), at least as fast as a stall is slow.
         let driving = matches!(self.mode, Mode::Running | Mode::Stopping(_));
         let want = inp.ref_omega.saturating_abs();
         let got = inp.crank_speed.saturating_abs();
-        let slow =
-            i64::from(got.to_bits()) * 65_536 < i64::from(want.to_bits()) * self.stall_frac_q16;
-        if driving && want >= self.stall_min && slow {
-            let since = *self.stall_since.get_or_insert(now_us);
-            if elapsed_us(since, now_us) >= self.stall_us {
-                self.fault(Fault::Stall);
+        let bar = i64::from(want.to_bits()) * self.stall_frac_q16;
+        let slow = i64::from(got.to_bits()) * 65_536 < bar;
+        let backwards = i64::from(inp.crank_speed.to_bits()) * 65_536 <= -bar;
+        let armed = driving && want >= self.stall_min;
+        if held(&mut self.stall_since, armed && slow, now_us, self.stall_us) {
+            self.fault(Fault::Stall);
+        }
+        if held(
+            &mut self.reverse_since,
+            armed && backwards,
+            now_us,
+            self.stall_us,
+        ) {
+            self.fault(Fault::WrongDirection);
+        }
+        // A cycle slip: the wrapped phase error jumps from beyond +π/2 to beyond −π/2 or back,
+        // with the crank turning the right way at speed (else it is a stall or a wrong
+        // direction, whose own checks name it).
+        let quarter = RadPerSec::from_bits(102_944); // π/2 in I16F16
+        let (e0, e1) = (self.last_phase_error, inp.phase_error);
+        self.last_phase_error = e1;
+        let slipped = (e0 > quarter && e1 < -quarter) || (e0 < -quarter && e1 > quarter);
+        if slipped && self.mode == Mode::Running && !inp.ramping && !slow && !backwards {
+            match self.last_slip_us {
+                Some(t) if elapsed_us(t, now_us) <= SLIP_WINDOW_US => {
+                    self.fault(Fault::PhaseLockLost)
+                }
+                _ => self.last_slip_us = Some(now_us),
             }
-        } else {
-            self.stall_since = None;
         }
         // Link silence: soft stop.
         if self.mode == Mode::Running && elapsed_us(self.last_link_us, inp.link_us) > self.link_us {
@@ -374,4 +458,14 @@ impl Supervisor {
             theta_d: self.theta,
         }
     }
+}
+
+/// A condition debounced by time: true once it has held for `for_us` since `since` (set when it
+/// began, cleared when it stops).
+fn held(since: &mut Option<u32>, cond: bool, now_us: u32, for_us: u32) -> bool {
+    if !cond {
+        *since = None;
+        return false;
+    }
+    elapsed_us(*since.get_or_insert(now_us), now_us) >= for_us
 }

@@ -13,7 +13,7 @@ use super::dds::{word_from_omega, Dds};
 use super::estimator::{Estimate, Estimator, Tuning};
 use super::fixed::{approx, trig, Angle, RadPerSec};
 use super::phase_lock::PhaseLock;
-use super::safety::{Inputs, Request, Supervisor};
+use super::safety::{Inputs, Mode, Request, Supervisor};
 
 /// FNV-1a, 64-bit (Fowler–Noll–Vo; offset basis and prime from the published parameters).
 #[derive(Debug, Clone, Copy)]
@@ -210,6 +210,9 @@ fn safety_script() -> u64 {
                 crank_speed: RadPerSec::from_num(if i == 7 { 5 } else { 100 }),
                 ref_omega: RadPerSec::from_num(100),
                 drive_stopped: k > 600,
+                sensor_failed: false,
+                phase_error: RadPerSec::ZERO,
+                ramping: false,
                 link_us: t,
             };
             let o = s.check(t, &inp);
@@ -316,6 +319,96 @@ fn rig_controller() -> u64 {
     d.finish()
 }
 
+/// The bench-fault logic: the AS5047P driver against the simulated chip (glitched commands, a
+/// cut cable, magnet loss), the e-stop debounce on a noisy line, the sample clock's skip rule,
+/// and the supervisor's wrong-direction and sensor faults.
+fn bench_faults() -> u64 {
+    use super::as5047::As5047;
+    use super::estop::EStop;
+    use crate::simrig::sensor::{Chip, Line, DIAAGC_NO_MAGNET, DIAAGC_OK};
+    let mut d = Digest::default();
+    let mut chip = Chip::default();
+    let mut drv = As5047::new();
+    for k in 0..5000u32 {
+        chip.angle = ((k * 37) & 0x3FFF) as u16;
+        chip.glitch_next_command = k % 97 == 13;
+        chip.line = if (2000..2050).contains(&k) {
+            Line::CutPulledUp
+        } else {
+            Line::Connected
+        };
+        chip.diagnostics = if (3000..4200).contains(&k) {
+            DIAAGC_NO_MAGNET
+        } else {
+            DIAAGC_OK
+        };
+        let r = drv.sample(k * 100, |w| Ok::<u16, ()>(chip.frame(w)));
+        d.u32(r.t_us);
+        match r.count {
+            Ok(c) => d.u32(u32::from(c)),
+            Err(e) => d.u32(0x1_0000 + e as u32),
+        }
+        d.u32(u32::from(drv.health().bad_run));
+        d.u32(u32::from(drv.health().failed()));
+    }
+    let mut e = EStop::new();
+    for k in 0..2000u32 {
+        let x = k.wrapping_mul(2_654_435_761) >> 27;
+        let reading = match k {
+            0..=9 => None,
+            500..=900 => Some(x != 0),
+            _ => Some(x == 0),
+        };
+        d.u32(u32::from(e.update(reading)));
+    }
+    let mut due = 0u64;
+    for k in 0..300u64 {
+        let now = due + (k * k * 7919) % 350;
+        let (n, skipped) = crate::station::next_due(due, now, 100);
+        d.u64(n);
+        d.u64(skipped);
+        due = n;
+    }
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    let mut t = 0u32;
+    for (i, speed) in [-100i32, -20, 100, 100, 100].into_iter().enumerate() {
+        d.u32(u32::from(s.request(Request::ClearFault).is_ok()));
+        d.u32(u32::from(
+            s.request(Request::Start { omega: 300.0 }).is_ok(),
+        ));
+        for k in 0..800u32 {
+            t = t.wrapping_add(1000);
+            s.heard_from_link(t);
+            let inp = Inputs {
+                estop: false,
+                // Segment 3 slips a cycle every 150 ticks; segment 4 draws 2.5 A (I²t).
+                current: RadPerSec::from_num(if i == 4 { 2.5 } else { 0.0 }),
+                crank_speed: RadPerSec::from_num(speed),
+                ref_omega: RadPerSec::from_num(100),
+                drive_stopped: false,
+                sensor_failed: i == 2 && k == 799,
+                phase_error: RadPerSec::from_num(match (i, k % 150) {
+                    (3, 0) => 3.0,
+                    (3, 1) => -3.0,
+                    _ => 0.0,
+                }),
+                ramping: false,
+                link_us: t,
+            };
+            let o = s.check(t, &inp);
+            d.u32(u32::from(o.halt));
+            d.u32(match s.mode() {
+                Mode::Idle => 0,
+                Mode::Running => 1,
+                Mode::Stopping(_) => 2,
+                Mode::Faulted(f) => 10 + f as u32,
+            });
+        }
+    }
+    d.finish()
+}
+
 /// Every scenario, in order.
 pub const CASES: &[Case] = &[
     Case {
@@ -352,5 +445,10 @@ pub const CASES: &[Case] = &[
         name: "estimator_synthetic",
         run: estimator_synthetic,
         expected: 0x0fa2_367a_4f61_e566,
+    },
+    Case {
+        name: "bench_faults",
+        run: bench_faults,
+        expected: 0x6296_a4a2_a9d5_b4f5,
     },
 ];

@@ -5,10 +5,12 @@
 //! | module | concept |
 //! |---|---|
 //! | [`plant`] | the pendulum driven by the crank's actual angle, the DC motor, friction |
+//! | [`sensor`] | the pendulum sensor's chip behind its SPI pins (AS5047P), with its faults |
 //!
 //! ```text
 //! every sample period h = 1/fs:
-//!   sensors → Sample (14-bit absolute angle with noise, the sensor's own zero and sign)
+//!   sensors → the AS5047P's register (14-bit angle with noise, its own zero and sign), read
+//!             through the firmware's driver (rig::as5047) → Sample
 //!   RigLoop::sample; when due RigLoop::control(crank counts, motor current, e-stop)
 //!                    → duty (0 while the bridge sleeps), θd for the servo
 //!   servo slews the mount toward θd at its own rate;  plant: one RK4 step of h
@@ -19,18 +21,21 @@
 //! Everything is deterministic under [`Params::seed`].
 
 pub mod plant;
+pub mod sensor;
 
 use crate::integrate::{rk4_step, Stats};
 use crate::link::message::Counters;
 use crate::math;
 use crate::model::Geometry;
 use crate::persist::ConfigOrigin;
+use crate::rig::as5047::{self, As5047};
 use crate::rig::config::RigConfig;
 use crate::rig::fixed::{Amps, Angle, Duty};
 use crate::rig::phase_lock::Motor;
 use crate::sim::noise::Noise;
 use crate::station::{RigLoop, Sample, Tick};
 use plant::{MotorModel, Plant};
+use sensor::Chip;
 
 /// Crank encoder counts per turn (a power of two, as the firmware's board constant).
 pub const CRANK_COUNTS: u32 = 4096;
@@ -132,6 +137,10 @@ pub struct SimRig {
     servo_target_deg: f64,
     servo_deg: f64,
     pub estop: bool,
+    chip: Chip,
+    driver: As5047,
+    /// The last good angle (a failed read repeats it, as the firmware does).
+    held: Angle,
     last_tick: Option<Tick>,
     stats: Stats,
 }
@@ -160,7 +169,7 @@ impl SimRig {
             duty: 0.0,
             jammed: false,
         };
-        Self {
+        let mut s = Self {
             rig: RigLoop::new(cfg, origin, Angle::from_deg(servo0), 0, firmware),
             plant,
             y: [params.theta0, 0.0, 0.0, 0.0],
@@ -169,10 +178,19 @@ impl SimRig {
             servo_target_deg: servo0,
             servo_deg: servo0,
             estop: false,
+            chip: Chip::default(),
+            driver: As5047::new(),
+            held: Angle::ZERO,
             last_tick: None,
             stats: Stats::default(),
             params,
-        }
+        };
+        // Prime the sensor's pipeline as the firmware does at power-up: the first answer
+        // belongs to no command.
+        s.chip.angle = s.sensor_code();
+        let chip = &mut s.chip;
+        s.driver.sample(0, |w| Ok::<u16, ()>(chip.frame(w)));
+        s
     }
 
     /// The same rig speaking link protocol `version`: for tests of version skew
@@ -195,11 +213,18 @@ impl SimRig {
     /// One sample period. `link_us` is the link's clock; `None`: the rig's own.
     pub fn step(&mut self, link_us: Option<u32>) {
         let t_us = self.t_us();
+        self.chip.angle = self.sensor_code();
+        let chip = &mut self.chip;
+        let read = self.driver.sample(t_us, |w| Ok::<u16, ()>(chip.frame(w)));
+        if let Ok(count) = read.count {
+            self.held = as5047::angle(count, 0, 1);
+        }
         let s = Sample {
-            t_us,
-            angle: self.sense(),
-            failed: false,
+            t_us: read.t_us,
+            angle: self.held,
+            failed: read.count.is_err(),
             late: false,
+            sensor_failed: self.driver.health().failed(),
         };
         if self.rig.sample(s) {
             let mut hw = Hardware {
@@ -268,6 +293,11 @@ impl SimRig {
         self.last_tick.as_ref()
     }
 
+    /// The pendulum sensor's chip and its line, to break them.
+    pub fn sensor(&mut self) -> &mut Chip {
+        &mut self.chip
+    }
+
     /// Jams the crank (a stalled motor) or frees it.
     pub fn jam(&mut self, jammed: bool) {
         self.plant.jammed = jammed;
@@ -290,16 +320,14 @@ impl SimRig {
         }
     }
 
-    /// What the pendulum sensor reports: its own zero and direction, noise, 14 bits, as the
-    /// firmware turns a sensor count into an angle (count · 2^18 of 2^32 per turn).
-    fn sense(&mut self) -> Angle {
+    /// The pendulum sensor's angle register: its own zero and direction, noise, 14 bits.
+    fn sensor_code(&mut self) -> u16 {
         let p = &self.params;
         let seen =
             p.sensor_sign * (self.y[0] - p.sensor_zero) + p.sensor_noise * self.noise.gaussian();
         let counts = f64::from(1u32 << SENSOR_BITS);
         let code = libm::round(seen / math::TAU * counts) as i64;
-        let code = code.rem_euclid(1 << SENSOR_BITS) as u32;
-        Angle::from_turns_u32(code << (32 - SENSOR_BITS))
+        code.rem_euclid(1 << SENSOR_BITS) as u16
     }
 
     /// The servo moves the mount toward its commanded position at its own rate.

@@ -33,13 +33,14 @@
 pub mod selftest;
 
 use crate::link::frame::{decode_request_as, encode, open, Header};
-use crate::link::message::Counters;
+use crate::link::message::{Counters, ResetInfo};
 use crate::link::serve::{Clock, Effect, RigServer};
 use crate::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 use crate::persist::ConfigOrigin;
 use crate::rig::config::RigConfig;
 use crate::rig::controller::ControlReport;
 use crate::rig::estimator::Tuning;
+use crate::rig::estop::EStop;
 use crate::rig::fixed::{Amps, Angle};
 use crate::rig::phase_lock::Motor;
 use crate::rig::safety::Mode;
@@ -62,6 +63,9 @@ pub struct Sample {
     pub failed: bool,
     /// Taken more than half a sample period late.
     pub late: bool,
+    /// The sensor's driver counts the sensor as failed (too many reads in a row without an
+    /// angle, or its magnet out of range: [`crate::rig::as5047::Health::failed`]).
+    pub sensor_failed: bool,
 }
 
 /// What the caller must do after a control tick.
@@ -134,8 +138,9 @@ pub struct RigLoop {
     telemetry_every: u32,
     since_telemetry: u32,
     telemetry_seq: u8,
-    /// The e-stop line at the last control tick.
+    /// The e-stop line at the last control tick, debounced.
     estop: bool,
+    estop_line: EStop,
     servo: Option<Angle>,
     store: Option<RigConfig>,
     last: Sample,
@@ -171,6 +176,7 @@ impl RigLoop {
             since_telemetry: 0,
             telemetry_seq: 0,
             estop: true,
+            estop_line: EStop::new(),
             servo: None,
             store: None,
             last: Sample {
@@ -178,10 +184,17 @@ impl RigLoop {
                 angle: Angle::ZERO,
                 failed: false,
                 late: false,
+                sensor_failed: false,
             },
             uptime_us: 0,
             current: Amps::ZERO,
         }
+    }
+
+    /// The same rig after a reset of `cause`, reported in the status.
+    pub fn after_reset(mut self, reset: ResetInfo) -> Self {
+        self.srv.reset = reset;
+        self
     }
 
     /// The same rig speaking protocol `version` on the link: for tests of what a host does
@@ -202,6 +215,7 @@ impl RigLoop {
         }
         self.uptime_us += u64::from(s.t_us.wrapping_sub(self.last.t_us));
         self.last = s;
+        self.srv.rig.sensor_failed(s.sensor_failed);
         self.srv.rig.sample(s.t_us, s.angle);
         self.since_control += 1;
         if self.since_control < self.samples_per_control {
@@ -212,9 +226,10 @@ impl RigLoop {
     }
 
     /// The control tick, at the time of the last sample. `link_us` is the link's clock (the
-    /// rig's own on hardware); `estop` the e-stop line, `None` while it is unknown (pressed).
+    /// rig's own on hardware); `estop` the e-stop line as read now, `None` while it is unknown
+    /// (pressed), debounced here ([`crate::rig::estop`]).
     pub fn control<M: Motor>(&mut self, link_us: u32, motor: &mut M, estop: Option<bool>) -> Tick {
-        self.estop = estop.unwrap_or(true);
+        self.estop = self.estop_line.update(estop);
         let t = self.last.t_us;
         let mut m = Metered {
             motor,
@@ -398,4 +413,40 @@ fn telemetry_ticks(period_ms: u16, cfg: &RigConfig) -> u32 {
     let ms = u64::from(period_ms.max(MIN_TELEMETRY_MS));
     let ticks = (ms * u64::from(cfg.control_hz)).div_ceil(1000);
     u32::try_from(ticks).unwrap_or(u32::MAX).max(1)
+}
+
+/// The sample clock's next deadline. A sample that was due at `due` ran at `now` (any clock's
+/// ticks, `period` per sample): the next is due one period after `due`, or — when that time
+/// has already passed — at the first period boundary still ahead, with the ticks in between
+/// skipped (returned as the second value) and never made up in a burst. A burst would pair
+/// stale samples with fresh drive phases and starve the control tick behind them; a skipped
+/// tick is an overrun ([`Sample::late`]).
+pub fn next_due(due: u64, now: u64, period: u64) -> (u64, u64) {
+    let period = period.max(1);
+    let next = due + period;
+    if now < next {
+        return (next, 0);
+    }
+    let skipped = (now - next) / period + 1;
+    (next + skipped * period, skipped)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn next_due_skips_missed_ticks_instead_of_bursting() {
+        // On time and a little late: the next boundary, nothing skipped.
+        assert_eq!(next_due(1000, 1000, 100), (1100, 0));
+        assert_eq!(next_due(1000, 1099, 100), (1100, 0));
+        // Exactly one period late: that boundary is now, so it is skipped.
+        assert_eq!(next_due(1000, 1100, 100), (1200, 1));
+        // 2.5 periods late: ticks at 1100 and 1200 skipped, the next at 1300 is ahead.
+        assert_eq!(next_due(1000, 1250, 100), (1300, 2));
+        // The deadline stays on the grid of `due` + k·period.
+        let (n, _) = next_due(1000, 98_765, 100);
+        assert_eq!((n - 1000) % 100, 0);
+        assert!(n > 98_765 && n <= 98_865);
+    }
 }

@@ -103,6 +103,7 @@ fn rig_loop_conversation() -> u64 {
             angle: Angle::from_rad(th),
             failed: k % 997 == 0,
             late: false,
+            sensor_failed: false,
         });
         if due {
             let tick = rig.control(t, &mut crank, Some(false));
@@ -126,5 +127,5 @@ fn rig_loop_conversation() -> u64 {
 pub const CASES: &[Case] = &[Case {
     name: "rig_loop_conversation",
     run: rig_loop_conversation,
-    expected: 0xefec_e74c_d044_90e8,
+    expected: 0x635e_cc64_88ce_2f03,
 }];

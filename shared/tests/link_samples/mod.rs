@@ -2,7 +2,8 @@
 //! round-trip, size and golden-frame tests.
 
 use kapitza_core::link::message::{
-    Counters, Fault, Mode, RMethod, StopReason, Telemetry, VersionInfo, WireConfig, WireGeometry,
+    Counters, Fault, Mode, RMethod, ResetCause, ResetInfo, StopReason, Telemetry, VersionInfo,
+    WireConfig, WireGeometry,
 };
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{Reason, Request, Response, Status};
@@ -38,6 +39,10 @@ pub fn status() -> Status {
             overruns: 1,
             frames_dropped: 2,
             commands: 77,
+        },
+        reset: ResetInfo {
+            cause: ResetCause::Watchdog,
+            last_fault: Some(Fault::PhaseLockLost),
         },
     }
 }
@@ -153,6 +158,20 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
         let mut s = status();
         s.config = o;
         v.push((name, 150 + i as u8, Resp(Response::Status(s))));
+    }
+    // The faults a bench latches, each as a status.
+    for (i, (name, f)) in [
+        ("status_faulted_sensor", Fault::Sensor),
+        ("status_faulted_wrong_direction", Fault::WrongDirection),
+        ("status_faulted_phase_lock_lost", Fault::PhaseLockLost),
+        ("status_faulted_over_current_rms", Fault::OverCurrentRms),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut s = status();
+        s.mode = Mode::Faulted(f);
+        v.push((name, 170 + i as u8, Resp(Response::Status(s))));
     }
     v
 }
