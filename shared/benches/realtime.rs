@@ -22,7 +22,7 @@ use std::time::Instant;
 const SIMULATED: f64 = 60.0;
 const TARGET: f64 = 1e-6;
 
-/// The example scene (R ≈ 3.3 at 135°) with Q = 50, for 60 s.
+/// The tilted example scene (R ≈ 3.3 at 135°) with Q = 50, for 60 s.
 fn scene(fidelity: Fidelity) -> Scene {
     Scene {
         pendulum: Geometry::rod(0.20).unwrap(),

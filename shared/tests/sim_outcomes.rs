@@ -8,7 +8,7 @@ use kapitza_core::sim::scene::{
 };
 use kapitza_core::sim::{simulate, Format, Method, Options, Outcome, Scene};
 
-/// The example: rod 0.20 m, A = 8.9 mm, ω = 330 rad/s, θd = 135°, Q = 50, from 100°.
+/// The tilted example scene: rod 0.20 m, A = 8.9 mm, ω = 330 rad/s, θd = 135°, Q = 50, from 100°.
 fn tilted() -> Scene {
     Scene {
         pendulum: Geometry::rod(0.20).unwrap(),

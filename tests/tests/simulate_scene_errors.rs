@@ -1,5 +1,5 @@
 //! Scene loading: every class of bad scene is refused before anything runs, with a message that
-//! names the file, the key, the bad value and what is allowed (issue #3, docs/scenes.md).
+//! names the file, the key, the bad value and what is allowed (docs/scenes.md).
 
 use kapitza::scene_file::parse;
 use kapitza_core::sim::scene::Viscous;

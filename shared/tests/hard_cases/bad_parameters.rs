@@ -1098,7 +1098,7 @@ fn hc09_rig_examples() {
     assert_eq!(name(1, 0.0), "length");
     assert_eq!(name(2, f64::NAN), "gravity");
     assert_eq!(name(0, 1e3), "amplitude");
-    // Each of these used to pass and then panic in the control loop: ki below one LSB of
+    // Each of these would validate and then panic in the control loop: ki below one LSB of
     // I16F16 (0: division by zero in the anti-windup limit), a stall fraction of 1e300 (i64
     // overflow in the stall test), a motor too slow for the duty conversion (i64 overflow).
     assert_eq!(name(14, 1e-9), "ki");

@@ -14,7 +14,7 @@ use kapitza_core::sim::scene::{Fidelity, FidelityChoice, RunLength};
 use kapitza_core::sim::wobble::Wobble;
 use kapitza_core::sim::{simulate, Method, Options, Recorder, Scene};
 
-/// The tilted example without damping (rod 0.20 m, A = 8.9 mm, ω = 330 rad/s,
+/// The tilted example scene without damping (rod 0.20 m, A = 8.9 mm, ω = 330 rad/s,
 /// θd = 135°, R = 3.30, from 100°), averaged: the slow swing lasts ≈ 33 drive periods.
 fn undamped(periods: f64) -> Scene {
     let mut s = scene(Geometry::rod(0.20).unwrap(), 0.0089, 330.0, 135.0);

@@ -154,7 +154,7 @@ mod tests {
 
     #[test]
     fn micromath_sqrt_is_crude() {
-        // The measurement: sqrt 2 → 1.5 (6 % high). Relative error stays within 6.1 %
+        // micromath's sqrt gives 1.5 for √2 (6 % high). Relative error stays within 6.1 %
         // over many decades (measured bound), which is why the rig never uses it.
         assert_eq!(sqrt_micromath(2.0), 1.5);
         let mut worst: f64 = 0.0;
