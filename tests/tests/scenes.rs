@@ -42,3 +42,31 @@ fn every_shipped_scene_meets_its_expectation() {
         assert!(kinds.contains(kind), "no shipped scene shows {kind}");
     }
 }
+
+/// The example in docs/scenes.md is a scene too, and meets its own `[expect]`.
+#[test]
+fn the_documented_example_meets_its_expectation() {
+    let doc = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/scenes.md"),
+    )
+    .unwrap();
+    let start = doc.find("```toml\n").expect("a toml example") + "```toml\n".len();
+    let end = start + doc[start..].find("```").unwrap();
+    let dir = std::env::temp_dir().join(format!("kapitza-doc-example-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("example.toml");
+    std::fs::write(&file, &doc[start..end]).unwrap();
+    let mut out = Vec::new();
+    let result = kapitza::run(
+        [
+            "kapitza",
+            "simulate",
+            file.to_str().unwrap(),
+            "--check",
+            "--json",
+        ],
+        &mut out,
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(result.is_ok(), "{}", String::from_utf8_lossy(&out));
+}
