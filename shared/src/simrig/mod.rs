@@ -33,7 +33,7 @@ use crate::rig::config::RigConfig;
 use crate::rig::fixed::{Amps, Angle, Duty};
 use crate::rig::phase_lock::Motor;
 use crate::sim::noise::Noise;
-use crate::station::{RigLoop, Sample, Tick};
+use crate::station::{RigLoop, Sample};
 use plant::{MotorModel, Plant};
 use sensor::Chip;
 
@@ -107,22 +107,6 @@ impl Params {
     }
 }
 
-/// The true state, for the truth log and the tests (never seen by the rig).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Truth {
-    /// Seconds since power-up.
-    pub t: f64,
-    /// Pendulum angle (rad, unwrapped) and rate (rad/s).
-    pub theta: f64,
-    pub theta_rate: f64,
-    /// Crank angle (rad) and speed (rad/s).
-    pub crank: f64,
-    pub crank_speed: f64,
-    /// The mount's true drive angle (deg).
-    pub theta_d_deg: f64,
-    pub duty: f64,
-}
-
 /// A whole simulated rig.
 #[derive(Debug, Clone)]
 pub struct SimRig {
@@ -141,7 +125,6 @@ pub struct SimRig {
     driver: As5047,
     /// The last good angle (a failed read repeats it, as the firmware does).
     held: Angle,
-    last_tick: Option<Tick>,
     stats: Stats,
 }
 
@@ -181,7 +164,6 @@ impl SimRig {
             chip: Chip::default(),
             driver: As5047::new(),
             held: Angle::ZERO,
-            last_tick: None,
             stats: Stats::default(),
             params,
         };
@@ -246,14 +228,10 @@ impl SimRig {
                 // The simulated flash always takes the write.
                 self.rig.config_saved(true);
             }
-            self.last_tick = Some(tick);
         }
         let h = 1.0 / f64::from(self.rig.sample_hz());
         self.slew_servo(h);
         self.y = rk4_step(&self.plant, self.seconds(), &self.y, h, &mut self.stats);
-        if self.plant.jammed {
-            self.y[3] = 0.0;
-        }
         self.k += 1;
     }
 
@@ -284,40 +262,9 @@ impl SimRig {
         self.rig.counters()
     }
 
-    pub fn params(&self) -> &Params {
-        &self.params
-    }
-
-    /// The last control tick's outputs.
-    pub fn last_tick(&self) -> Option<&Tick> {
-        self.last_tick.as_ref()
-    }
-
     /// The pendulum sensor's chip and its line, to break them.
     pub fn sensor(&mut self) -> &mut Chip {
         &mut self.chip
-    }
-
-    /// Jams the crank (a stalled motor) or frees it.
-    pub fn jam(&mut self, jammed: bool) {
-        self.plant.jammed = jammed;
-    }
-
-    /// Right-hand-side evaluations so far (the physics' cost).
-    pub fn stats(&self) -> &Stats {
-        &self.stats
-    }
-
-    pub fn truth(&self) -> Truth {
-        Truth {
-            t: self.seconds(),
-            theta: self.y[0],
-            theta_rate: self.y[1],
-            crank: self.y[2],
-            crank_speed: self.y[3],
-            theta_d_deg: math::to_deg(self.plant.theta_d),
-            duty: self.plant.duty,
-        }
     }
 
     /// The pendulum sensor's angle register: its own zero and direction, noise, 14 bits.

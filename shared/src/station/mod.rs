@@ -134,7 +134,9 @@ pub struct RigLoop {
     out: Outbox,
     samples_per_control: u32,
     since_control: u32,
-    /// Telemetry every this many control ticks (0: off), and the ticks since the last one.
+    /// The telemetry period asked for (ms; 0: off), the same in control ticks, and the ticks
+    /// since the last frame.
+    telemetry_ms: u16,
     telemetry_every: u32,
     since_telemetry: u32,
     telemetry_seq: u8,
@@ -172,6 +174,7 @@ impl RigLoop {
             reader: FrameReader::new(),
             out: Outbox::new(),
             since_control: 0,
+            telemetry_ms: 0,
             telemetry_every: 0,
             since_telemetry: 0,
             telemetry_seq: 0,
@@ -347,21 +350,16 @@ impl RigLoop {
             Effect::StoreConfig(cfg) => {
                 self.samples_per_control = per_control(&cfg);
                 self.since_control = 0;
-                self.telemetry_every = telemetry_ticks(self.telemetry_ms(), &cfg);
+                self.telemetry_every = telemetry_ticks(self.telemetry_ms, &cfg);
                 self.store = Some(cfg);
             }
             Effect::Telemetry { period_ms } => {
+                self.telemetry_ms = period_ms;
                 self.telemetry_every = telemetry_ticks(period_ms, &self.srv.cfg);
                 self.since_telemetry = self.telemetry_every.saturating_sub(1);
             }
         }
         resp
-    }
-
-    /// The telemetry period in use (ms; 0 when off).
-    fn telemetry_ms(&self) -> u16 {
-        let hz = self.srv.cfg.control_hz.max(1);
-        u16::try_from(u64::from(self.telemetry_every) * 1000 / u64::from(hz)).unwrap_or(u16::MAX)
     }
 
     /// Frames `resp` into the outbox. Telemetry leaves room for one answer behind it.
