@@ -82,6 +82,8 @@ pub fn run_with(args: &Args, lister: &Lister, out: &mut dyn Write) -> Result<()>
         None => firmware_build::build(&firmware_build::firmware_dir()?)?,
     };
     let plan = image::check_file(&elf, &map)?;
+    let cwd = std::env::current_dir()?;
+    let elf = elf.strip_prefix(&cwd).unwrap_or(&elf).to_path_buf();
     if args.dry_run {
         if args.json {
             let report = DryRun {
