@@ -37,7 +37,8 @@ pub struct Args {
     /// The microcontroller, as probe-rs names it.
     #[arg(long, default_value = DEFAULT_CHIP, value_name = "NAME")]
     pub chip: String,
-    /// Do not reset after flashing: the core stays halted, and the version is not checked.
+    /// Do not reset after flashing: the new firmware starts at the next reset, and the version
+    /// is not checked.
     #[arg(long)]
     pub no_reset: bool,
     /// After flashing, watch the rig (`kapitza monitor` on the board's port).
@@ -123,8 +124,8 @@ pub fn run_with(args: &Args, lister: &Lister, out: &mut dyn Write) -> Result<()>
     if args.no_reset {
         writeln!(
             out,
-            "not reset (--no-reset): the core is halted; press the board's black reset button (B2) \
-             to start the firmware"
+            "not reset (--no-reset): the new firmware starts at the next reset (the board's \
+             black button, B2)"
         )?;
         return Ok(());
     }

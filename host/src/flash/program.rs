@@ -18,7 +18,7 @@ use super::probes::permission_denied;
 use crate::rig::{Exit, Failure};
 
 /// Flashes `elf` onto `chip` through the probe `info` names, verifies it, and resets the core
-/// unless `reset` is false (then it stays halted).
+/// unless `reset` is false (then the new image runs from the next reset).
 pub fn program(info: &DebugProbeInfo, chip: &str, elf: &Path, reset: bool) -> Result<()> {
     let probe = info.open().map_err(|e| {
         if denied(&e) {
