@@ -143,3 +143,23 @@ fn name(op: ProgressOperation) -> &'static str {
         ProgressOperation::Verify => "verify",
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use probe_rs::probe::{DebugProbeError, ProbeCreationError};
+    use std::io::{Error, ErrorKind};
+
+    /// nusb reports a USB node the user may not open as an I/O error, wrapped once or twice.
+    #[test]
+    fn permission_is_found_in_the_error_chain() {
+        let usb = DebugProbeError::Usb(Error::from(ErrorKind::PermissionDenied));
+        assert!(denied(&usb));
+        let nested = DebugProbeError::ProbeCouldNotBeCreated(ProbeCreationError::Usb(Error::from(
+            ErrorKind::PermissionDenied,
+        )));
+        assert!(denied(&nested));
+        let other = DebugProbeError::Usb(Error::from(ErrorKind::TimedOut));
+        assert!(!denied(&other));
+    }
+}
