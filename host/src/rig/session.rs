@@ -62,6 +62,19 @@ pub fn open(target: &Target, sim: &SimOptions) -> Result<Session> {
 pub fn check(port: Box<dyn ReadWrite>, name: String, via_owner: bool) -> Result<Session> {
     let mut client = Client::new(port).with_timeout(ANSWER_TIMEOUT);
     let version = client.version().map_err(|e| line_failure(&name, e))?;
+    check_version(&version, &name)?;
+    let config = client.config().map_err(|e| line_failure(&name, e))?;
+    Ok(Session {
+        client,
+        version,
+        config,
+        name,
+        via_owner,
+    })
+}
+
+/// Refuses a rig that speaks another link protocol than this host tool.
+pub fn check_version(version: &VersionInfo, name: &str) -> Result<()> {
     if version.protocol != PROTOCOL_VERSION {
         return Err(Failure::new(
             Exit::NoRig,
@@ -74,14 +87,7 @@ pub fn check(port: Box<dyn ReadWrite>, name: String, via_owner: bool) -> Result<
         )
         .into());
     }
-    let config = client.config().map_err(|e| line_failure(&name, e))?;
-    Ok(Session {
-        client,
-        version,
-        config,
-        name,
-        via_owner,
-    })
+    Ok(())
 }
 
 /// A failed call in terms of its exit status: refused (1) or the line (3).
