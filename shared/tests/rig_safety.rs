@@ -94,6 +94,7 @@ proptest! {
                             drive_stopped: dds.is_stopped(),
                             sensor_failed: false,
                             phase_error: RadPerSec::ZERO,
+                            duty_saturated: false,
                             ramping: false,
                             link_us: t,
                         };
@@ -142,6 +143,7 @@ fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
         drive_stopped: stopped,
         sensor_failed: false,
         phase_error: RadPerSec::ZERO,
+        duty_saturated: false,
         ramping: false,
         link_us: 0,
     }
