@@ -58,20 +58,30 @@ unsafe fn UART4() {
 /// datasheet's tL, tH and tCSn are ≥ 350 ns ("SPI Timing"), 60 cycles at 170 MHz (352 ns).
 const CS_CYCLES: u32 = 60;
 
-/// SYSCLK = 170 MHz (the G474's maximum) from the internal 16 MHz HSI.
+/// SYSCLK = 170 MHz (the G474's maximum) from the board's 24 MHz crystal X3 (HSE).
 ///
-/// PLL: 16 MHz / 4 = 4 MHz input (allowed 2.66..16 MHz), × 85 = 340 MHz VCO (allowed
+/// Why the crystal: the HSI is ±1 % over temperature (STM32G474 datasheet, "HSI16"), and the
+/// drive's ω is counted in this clock, so R ∝ ω² would be off by up to ±2 %; a crystal is tens
+/// of ppm. The NUCLEO-G474RE (MB1367) carries X3 = 24 MHz fitted and wired to OSC_IN/OSC_OUT by
+/// default (docs/hardware.md, "Clock", for the sources). HSE in oscillator mode (HSEBYP = 0),
+/// not bypass: it is a crystal, not the ST-LINK's MCO.
+///
+/// PLL: 24 MHz / 6 = 4 MHz input (allowed 2.66..16 MHz), × 85 = 340 MHz VCO (allowed
 /// 96..344 MHz), / 2 on the R output = 170 MHz SYSCLK. Above 150 MHz the core regulator must be in
 /// range 1 boost mode. AHB and both APBs run undivided at 170 MHz (all allow up to 170 MHz).
-/// The HSI is used rather than the board's HSE so the firmware does not depend on the NUCLEO's
-/// crystal/solder-bridge configuration. ADC1/2 run from SYSCLK (divided below 60 MHz by the
-/// driver).
+/// ADC1/2 run from SYSCLK (divided below 60 MHz by the driver). embassy-stm32 waits for HSERDY
+/// before anything else runs: a board without its crystal hangs here, before the watchdog
+/// starts, with the bridge asleep (nSLEEP has its pull-down) — the bring-up checklist's first
+/// step shows it.
 pub fn chip_config() -> Config {
     let mut config = Config::default();
-    config.rcc.hsi = true;
+    config.rcc.hse = Some(rcc::Hse {
+        freq: Hertz(24_000_000),
+        mode: rcc::HseMode::Oscillator,
+    });
     config.rcc.pll = Some(rcc::Pll {
-        source: rcc::PllSource::HSI,
-        prediv: rcc::PllPreDiv::DIV4,
+        source: rcc::PllSource::HSE,
+        prediv: rcc::PllPreDiv::DIV6,
         mul: rcc::PllMul::MUL85,
         divp: None,
         divq: None,
