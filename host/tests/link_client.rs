@@ -77,6 +77,17 @@ impl Read for Line {
     }
 }
 
+/// Waits out a start's pre-run check (0.6 s of rig time; each status poll lets ≥ 1 ms pass)
+/// and returns the mode after it.
+fn after_check(c: &mut Client<Line>) -> Mode {
+    loop {
+        let m = c.status().unwrap().mode;
+        if m != Mode::Checking {
+            return m;
+        }
+    }
+}
+
 fn client(rig: Line) -> Client<Line> {
     Client::new(rig).with_timeout(Duration::from_millis(50))
 }
@@ -91,7 +102,8 @@ fn every_command() {
     assert_eq!(s.config, ConfigOrigin::Defaults(Fallback::Missing));
 
     c.set_drive(3.0, 180.0).unwrap();
-    assert_eq!(c.status().unwrap().mode, Mode::Running);
+    assert_eq!(c.status().unwrap().mode, Mode::Checking);
+    assert_eq!(after_check(&mut c), Mode::Running);
     c.stop().unwrap();
     assert!(matches!(c.status().unwrap().mode, Mode::Stopping(_)));
     c.clear_fault().unwrap();
@@ -132,6 +144,7 @@ fn configuration_round_trip() {
     // R = 6 needs ω = ωc √6 = 369.1 rad/s with A = 12 mm (ωc = √(2gℓ)/A = 150.7 rad/s), below
     // the new 400 rad/s limit; R = 8 needs 426.2 rad/s, above it.
     c.set_drive(6.0, 0.0).unwrap();
+    assert_eq!(after_check(&mut c), Mode::Running);
     assert!(matches!(
         c.set_drive(8.0, 0.0),
         Err(Error::Refused(Reason::OmegaAboveLimit { .. }))
@@ -159,8 +172,11 @@ fn a_noisy_line_is_retried_and_never_misapplied() {
     let mut c = client(rig);
     c.set_drive(2.0, 45.0).unwrap();
     let rig = c.into_inner();
-    // The damaged copy was refused (BadCrc) and changed nothing; the retry applied exactly R, θd.
+    // The damaged copy was refused (BadCrc) and changed nothing; the retry applied exactly R, θd
+    // (once its pre-run check passed).
     assert_eq!(rig.frames_in, 2);
+    let mut rig = rig;
+    rig.rig.run(0.7);
     let sup = rig.rig.rig().server().rig.supervisor();
     assert_eq!(sup.mode(), safety::Mode::Running);
     let w = kapitza_core::rig::dds::omega_of_word(sup.target_word());
@@ -228,6 +244,7 @@ fn faulted_within(params: Params, wire: SensorLine, start: bool, ms: u32) -> (Cl
     let mut c = client(Line::on(rig));
     if start {
         c.set_drive(3.0, 0.0).unwrap();
+        after_check(&mut c);
     }
     let mut mode = c.status().unwrap().mode;
     for _ in 0..ms {
@@ -250,8 +267,8 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
         other => panic!("{other:?}"),
     }
     // Swapped crank-encoder channels, and swapped motor leads: the crank turns against the
-    // drive; with the reference limits (ramp 60 rad/s², bar at 20 rad/s, 300 ms debounce) the
-    // fault comes ≈ 0.65 s after the start; 3 s is the bound.
+    // drive. The pre-run check's test pulse sees it before any start and refuses it (the
+    // WrongDirection fault is for a reversal while running: rig_safety, closed_loop_safety).
     for params in [
         Params {
             crank_sign: -1.0,
@@ -266,11 +283,13 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
         },
     ] {
         let (mut c, mode) = faulted_within(params, SensorLine::Connected, true, 3000);
-        assert_eq!(mode, Mode::Faulted(Fault::WrongDirection));
-        match c.set_drive(3.0, 0.0) {
-            Err(Error::Refused(Reason::Faulted(Fault::WrongDirection))) => {}
-            other => panic!("{other:?}"),
-        }
+        assert_eq!(mode, Mode::Idle);
+        assert!(matches!(
+            c.status().unwrap().check,
+            Some(kapitza_core::link::message::Check::Failed(
+                kapitza_core::link::message::Verdict::CrankReversed { .. }
+            ))
+        ));
     }
     // A motor too weak for the set ω: 300 rad/s at full duty (back-EMF matched, so its current
     // stays low) against ω = ωc√3 = 313 rad/s. The crank runs at ≥ 96 % of ω, no stall, but
