@@ -160,3 +160,27 @@ fn link_silence_and_faults_end_it() {
         Response::Refused(Reason::Faulted(Fault::EStop))
     );
 }
+
+#[test]
+fn a_start_or_a_new_configuration_leaves_it() {
+    let mut b = Bench::healthy(Params::DEMO);
+    b.ask(Request::BringUp {
+        duty: q15(0.1),
+        theta_d_deg: 0,
+    });
+    // A start from bring-up: the pre-run check takes over (the crank coasting from the
+    // bring-up duty settles during its rest phase), then the drive runs.
+    let s = b.start();
+    assert_eq!(s.check, Some(kapitza_core::link::message::Check::Passed));
+    assert_eq!((s.mode, s.bring_up), (Mode::Running, None));
+    // A new configuration while in bring-up: taken, and bring-up is over.
+    let mut b = Bench::healthy(Params::DEMO);
+    b.ask(Request::BringUp {
+        duty: q15(0.1),
+        theta_d_deg: 0,
+    });
+    let mut cfg = Params::DEMO.configured();
+    cfg.calibration.pendulum_zero = 100;
+    assert_eq!(b.ask(Request::SetConfig(cfg.into())), Response::Ok);
+    assert_eq!(b.status().bring_up, None);
+}

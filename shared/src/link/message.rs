@@ -66,8 +66,9 @@ pub enum Request {
     /// Bring-up mode (from idle, or to change it): the crank motor at an open-loop `duty`
     /// no larger than the bring-up cap (`station::bring_up`), the servo jogged to θd (degrees
     /// along the travel, I16F16, slewed), and [`Response::Raw`] streamed instead of
-    /// [`Response::Telemetry`]. [`Request::Stop`] or link silence leaves it (duty 0); faults
-    /// stop it as they stop the drive.
+    /// [`Response::Telemetry`]. [`Request::Stop`], link silence or a new configuration leaves
+    /// it (duty 0), and so does a start (for its pre-run check); faults stop it as they stop
+    /// the drive.
     BringUp { duty: Q15, theta_d_deg: Q16 },
 }
 
