@@ -309,3 +309,40 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
     let (_, mode) = faulted_within(Params::DEMO, SensorLine::Connected, true, 2000);
     assert_eq!(mode, Mode::Running);
 }
+
+#[test]
+fn bring_up_streams_the_raw_sensors() {
+    let mut c = client(Line::new());
+    c.bring_up(0.1, 0.0).unwrap();
+    assert_eq!(c.status().unwrap().bring_up, Some(3_277));
+    c.stream_telemetry(20).unwrap();
+    // Let the motor reach its speed (τ = 60 ms), then 0.5 s of frames: the crank turns
+    // forwards at 0.1 · 450 rad/s (the demo motor), 45/(2π) · 0.5 = 3.58 turns, summed frame
+    // by frame (a 20 ms frame is 0.14 turn, well inside the half turn a wrapped difference
+    // holds).
+    let mut a = c.raw_telemetry().unwrap();
+    while c.raw_telemetry().unwrap().t_us.wrapping_sub(a.t_us) < 300_000 {}
+    a = c.raw_telemetry().unwrap();
+    let (start, mut b, mut turns) = (a, a, 0.0);
+    while b.t_us.wrapping_sub(start.t_us) < 500_000 {
+        let n = c.raw_telemetry().unwrap();
+        turns += f64::from(n.crank.wrapping_sub(b.crank) as i32) / 4_294_967_296.0;
+        b = n;
+    }
+    let secs = f64::from(b.t_us.wrapping_sub(start.t_us)) * 1e-6;
+    let rate = turns / secs;
+    assert!(
+        (rate - 45.0 / std::f64::consts::TAU).abs() < 0.1,
+        "{rate} turns/s"
+    );
+    assert_eq!(b.duty, 3_277);
+    assert!(b.pendulum.is_some() && b.diagnostics.is_some_and(|d| d.ready));
+    // Above the cap: refused by the rig; not a number: not even sent.
+    assert!(matches!(
+        c.bring_up(0.5, 0.0),
+        Err(Error::Refused(Reason::DutyAboveCap { .. }))
+    ));
+    assert!(matches!(c.bring_up(f64::NAN, 0.0), Err(Error::Invalid(_))));
+    c.stop().unwrap();
+    assert_eq!(c.status().unwrap().bring_up, None);
+}

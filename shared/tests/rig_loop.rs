@@ -257,6 +257,31 @@ fn the_servo_is_told_only_when_theta_d_moves() {
 }
 
 #[test]
+fn the_servo_pulse_comes_from_the_configured_map() {
+    // A servo whose middle (1500 µs) points at θd = 100° over 180° of range, 1000–2000 µs:
+    // θd = 10° is 90° below the centre, 90 · 1000/180 = 500 µs below 1500 µs.
+    let mut cfg = CFG;
+    cfg.calibration.servo = kapitza_core::rig::servo::ServoMap {
+        min_us: 1000,
+        max_us: 2000,
+        range_deg: 180.0,
+        centre_deg: 100.0,
+    };
+    let mut b = Bench::new(ConfigOrigin::Stored);
+    b.rig = RigLoop::new(
+        cfg,
+        ConfigOrigin::Stored,
+        Angle::from_deg(10.0),
+        0,
+        [0, 1, 0],
+    );
+    b.run_ms(2);
+    let us: Vec<f64> = b.ticks.iter().filter_map(|t| t.servo_us).collect();
+    assert_eq!(us.len(), 1);
+    assert!((us[0] - 1000.0).abs() < 1e-6, "{us:?}");
+}
+
+#[test]
 fn the_same_configuration_is_not_stored_again() {
     let mut b = Bench::new(ConfigOrigin::Stored);
     b.send(1, &Request::SetConfig(CFG.into()));

@@ -183,6 +183,26 @@ mod tests {
     }
 
     #[test]
+    fn the_duty_is_clamped_at_the_configured_ceiling() {
+        // Feed-forward alone at ω = 400 rad/s asks for 400/500 = 0.8 of full duty.
+        let w = RadPerSec::from_num(400);
+        let mut pl = PhaseLock::new(&RigConfig::REFERENCE);
+        let out = pl.update(true, Angle::ZERO, w, RadPerSec::ZERO, Angle::ZERO);
+        assert!((out.duty.to_num::<f64>() - 0.8).abs() < 1e-4);
+        assert!(!out.saturated);
+        // With a ceiling of 0.5: clamped to 0.5 (16384 in I1F15), and said so.
+        let mut cfg = RigConfig::REFERENCE;
+        cfg.limits.duty_max = 0.5;
+        let mut pl = PhaseLock::new(&cfg);
+        let out = pl.update(true, Angle::ZERO, w, RadPerSec::ZERO, Angle::ZERO);
+        assert_eq!(out.duty.to_bits(), 16_384);
+        assert!(out.saturated);
+        // Backwards too.
+        let out = pl.update(true, Angle::ZERO, -w, RadPerSec::ZERO, Angle::ZERO);
+        assert_eq!(out.duty.to_bits(), -16_384);
+    }
+
+    #[test]
     fn correction_is_bounded_and_integrator_does_not_wind_up() {
         // A stuck crank at a 90° phase error for 100 s: the correction stays at ±c_max (40 rad/s)
         // and the integrator at c_max/ki, so on release it has no stored windup beyond that.
