@@ -40,6 +40,7 @@ pub struct Rig {
     sup: Supervisor,
     sensor_failed: bool,
     phase_error: RadPerSec,
+    saturated: bool,
 }
 
 impl Rig {
@@ -53,6 +54,7 @@ impl Rig {
             sup: Supervisor::new(cfg, theta_d0, now_us),
             sensor_failed: false,
             phase_error: RadPerSec::ZERO,
+            saturated: false,
         }
     }
 
@@ -103,6 +105,7 @@ impl Rig {
             drive_stopped: self.dds.is_stopped(),
             sensor_failed: self.sensor_failed,
             phase_error: self.phase_error,
+            duty_saturated: self.saturated,
             ramping: self.dds.is_ramping(),
             link_us,
         };
@@ -124,6 +127,7 @@ impl Rig {
         );
         motor.set_duty(lock.duty);
         self.phase_error = lock.error;
+        self.saturated = lock.saturated;
         let steady = run
             && !self.dds.is_ramping()
             && self.dds.word() > 0
@@ -144,6 +148,10 @@ impl Rig {
 
     pub fn estimate(&self) -> &Estimate {
         self.est.estimate()
+    }
+    /// The fast wobble's amplitude over the latest drive period (rad, Q30).
+    pub fn wobble(&self) -> super::fixed::Unit {
+        self.est.wobble_now()
     }
     pub fn dds(&self) -> &Dds {
         &self.dds
