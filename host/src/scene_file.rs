@@ -21,7 +21,7 @@ use kapitza_core::model::{DriveAngle, Geometry};
 use kapitza_core::sim::scene::{
     DriveFrequency, DriveSpec, Effects, Fidelity, FidelityChoice, RunLength, Sensor, Viscous,
 };
-use kapitza_core::sim::{fidelity, Format, Method, Scene};
+use kapitza_core::sim::{fidelity, Controller, Format, Method, Scene};
 use kapitza_core::ParamError;
 
 /// RK4 steps per drive period when `run.steps_per_period` is not given.
@@ -34,6 +34,8 @@ pub struct SceneFile {
     pub title: String,
     pub scene: Scene,
     pub method: Method,
+    /// The adaptive method's step controller (`run.controller`).
+    pub controller: Controller,
     pub format: Format,
     /// Seed of the sensor noise.
     pub seed: u64,
@@ -241,6 +243,14 @@ enum MethodName {
 
 #[derive(Debug, Clone, Copy, Default, Deserialize)]
 #[serde(rename_all = "lowercase")]
+enum ControllerName {
+    #[default]
+    Standard,
+    Pi,
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
 enum FormatName {
     #[default]
     F64,
@@ -259,6 +269,8 @@ struct RawRun {
     rtol: Option<f64>,
     atol: Option<f64>,
     steps_per_period: Option<f64>,
+    #[serde(default)]
+    controller: ControllerName,
     #[serde(default)]
     format: FormatName,
     seed: Option<u64>,
@@ -431,10 +443,19 @@ fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     if matches!(method, Method::Symplectic { .. }) && p.c > 0.0 {
         bail!("run.method: symplectic methods integrate undamped motion only: remove effects.viscous, or use \"dop853\" or \"rk4\"");
     }
+    let controller = match run.controller {
+        ControllerName::Standard => Controller::Standard,
+        ControllerName::Pi => Controller::Pi,
+    };
+    let decided = fidelity::decide(&scene, &p).map_err(|e| anyhow!("{e}"))?;
+    if controller == Controller::Pi && !method.has_step_controller(decided.fidelity) {
+        bail!("run.controller = \"pi\" needs a method with an adaptive step: allowed with \"dop853\" (or \"auto\"), or \"rkn86\" on the averaged model (fixed-step methods have no step controller; rkn86 on the full model chooses whole steps per drive period)");
+    }
     Ok(SceneFile {
         title: raw.title.unwrap_or_else(|| stem.to_string()),
         scene,
         method,
+        controller,
         format: match run.format {
             FormatName::F64 => Format::F64,
             FormatName::F32 => Format::F32,

@@ -286,15 +286,16 @@ pub fn realtime_table(r: &Results) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| model | method | rtol = atol | final error | CPU per 60 s run | real-time factor |"
+        "| model | method | controller | rtol = atol | final error | CPU per 60 s run | real-time factor |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
     for f in &r.real_time_factors {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             f.model,
             f.method,
+            f.controller,
             sci(f.setting),
             sci(f.error),
             secs(f.cpu_s),

@@ -151,6 +151,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     };
     let options = Options {
         method: file.method,
+        controller: file.controller,
         format: file.format,
         out_dt,
         seed: file.seed,

@@ -13,6 +13,7 @@
 //! | [`noise`] | seeded, reproducible uniform and Gaussian noise |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
 //! | `periodic` | the full equation by RKN 8(6), a whole number of steps per drive period |
+//! | `slow` | the averaged equation by adaptive RKN 8(6), no libm sin/cos per evaluation |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
 //! | [`run`] | `simulate`: compose, integrate, sample, classify |
@@ -29,10 +30,11 @@ pub mod sampling;
 pub mod scene;
 pub mod sensor;
 pub mod signal;
+mod slow;
 mod turns;
 pub mod wobble;
 
 pub use classify::Outcome;
-pub use run::{simulate, Format, Method, Options, Report, SimError};
+pub use run::{simulate, Controller, Format, Method, Options, Report, SimError};
 pub use sampling::Recorder;
 pub use scene::Scene;

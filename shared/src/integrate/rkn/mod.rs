@@ -23,6 +23,7 @@
 //! the same every step: they are computed once, and damping costs nothing per evaluation.
 //! (c → 0 gives s = τ and the plain method; expm1 and log1p keep small cH exact.)
 
+pub mod adaptive;
 pub mod tableau;
 
 #[cfg(test)]
@@ -61,18 +62,34 @@ pub struct RknStep<R> {
 impl DampedRkn {
     /// Steps of size `h` with damping `c` ≥ 0.
     pub fn new(h: f64, c: f64) -> Self {
+        Self::build(h, c, true)
+    }
+
+    /// The same for a g that does not depend on t: the stage times (one log1p each) are left
+    /// out and [`DampedRkn::tau`] is NaN. What an adaptive run of an autonomous equation,
+    /// building a new step size every step, wants.
+    pub fn autonomous(h: f64, c: f64) -> Self {
+        Self::build(h, c, false)
+    }
+
+    fn build(h: f64, c: f64, times: bool) -> Self {
         let ch = c * h;
-        // S = (1 − e^(−cH))/c; τ(s) = −ln(1 − c s)/c.
-        let s = if c > 0.0 { -libm::expm1(-ch) / c } else { h };
-        let mut tau = [0.0; STAGES];
+        // S = (1 − e^(−cH))/c; τ(s) = −ln(1 − c s)/c; e^(−cH) = 1 − c S.
+        let expm1 = libm::expm1(-ch);
+        let s = if c > 0.0 { -expm1 / c } else { h };
+        let mut tau = [f64::NAN; STAGES];
         let mut weight = [1.0; STAGES];
         for i in 0..STAGES {
+            let x = c * C[i] * s;
             if c > 0.0 {
-                let x = c * C[i] * s;
-                tau[i] = -libm::log1p(-x) / c;
                 weight[i] = 1.0 / ((1.0 - x) * (1.0 - x));
-            } else {
-                tau[i] = C[i] * h;
+            }
+            if times {
+                tau[i] = if c > 0.0 {
+                    -libm::log1p(-x) / c
+                } else {
+                    C[i] * h
+                };
             }
         }
         Self {
@@ -80,7 +97,7 @@ impl DampedRkn {
             s,
             tau,
             weight,
-            decay: if c > 0.0 { libm::exp(-ch) } else { 1.0 },
+            decay: 1.0 + expm1,
         }
     }
 
