@@ -235,6 +235,7 @@ enum MethodName {
     Auto,
     Dop853,
     Rkn86,
+    Rkn1210,
     Rk4,
     Verlet,
     Yoshida4,
@@ -449,7 +450,7 @@ fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     };
     let decided = fidelity::decide(&scene, &p).map_err(|e| anyhow!("{e}"))?;
     if controller == Controller::Pi && !method.has_step_controller(decided.fidelity) {
-        bail!("run.controller = \"pi\" needs a method with an adaptive step: allowed with \"dop853\" (or \"auto\"), or \"rkn86\" on the averaged model (fixed-step methods have no step controller; rkn86 on the full model chooses whole steps per drive period)");
+        bail!("run.controller = \"pi\" needs a method with an adaptive step: allowed with \"dop853\" (or \"auto\"), \"rkn1210\", or \"rkn86\" on the averaged model (fixed-step methods have no step controller; rkn86 on the full model chooses whole steps per drive period)");
     }
     Ok(SceneFile {
         title: raw.title.unwrap_or_else(|| stem.to_string()),
@@ -572,7 +573,7 @@ fn method(run: &RawRun) -> Result<Method> {
     let fixed_step = |name: &str| -> Result<f64> {
         for (key, v) in [("rtol", run.rtol), ("atol", run.atol)] {
             if let Some(v) = v {
-                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\" and \"rkn86\")");
+                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\", \"rkn86\" and \"rkn1210\")");
             }
         }
         run.steps_per_period.map_or(Ok(DEFAULT_RK4_STEPS), |s| {
@@ -592,7 +593,7 @@ fn method(run: &RawRun) -> Result<Method> {
         MethodName::Verlet => symplectic(Symplectic::Verlet, "verlet"),
         MethodName::Yoshida4 => symplectic(Symplectic::Yoshida4, "yoshida4"),
         MethodName::Yoshida6 => symplectic(Symplectic::Yoshida6, "yoshida6"),
-        MethodName::Auto | MethodName::Dop853 | MethodName::Rkn86 => {
+        MethodName::Auto | MethodName::Dop853 | MethodName::Rkn86 | MethodName::Rkn1210 => {
             if let Some(s) = run.steps_per_period {
                 bail!("run.steps_per_period = {s} is not allowed with an adaptive method: allowed only with a fixed-step method (rk4, verlet, yoshida4, yoshida6)");
             }
@@ -603,6 +604,7 @@ fn method(run: &RawRun) -> Result<Method> {
             let atol = run.atol.map_or(Ok(atol), |v| positive("run.atol", v))?;
             Ok(match run.method {
                 MethodName::Rkn86 => Method::Rkn86 { rtol, atol },
+                MethodName::Rkn1210 => Method::Rkn1210 { rtol, atol },
                 _ => Method::Dop853 { rtol, atol },
             })
         }

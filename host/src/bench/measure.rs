@@ -38,6 +38,8 @@ pub enum Family {
     Rkn86,
     /// Our DOP853 with the PI step controller (`run.controller = "pi"`); setting: rtol = atol.
     Dop853Pi,
+    /// Our adaptive RKN 12(10); setting: rtol = atol.
+    Rkn1210,
     /// Störmer–Verlet; setting: steps per drive period.
     Verlet,
     /// Yoshida's 4th-order composition; setting: steps per drive period.
@@ -65,6 +67,7 @@ impl Family {
             Family::Dop853 => "dop853",
             Family::Rkn86 => "rkn86",
             Family::Dop853Pi => "dop853-pi",
+            Family::Rkn1210 => "rkn1210",
             Family::Verlet => "verlet",
             Family::Yoshida4 => "yoshida4",
             Family::Yoshida6 => "yoshida6",
@@ -84,6 +87,7 @@ impl Family {
             Family::Dop853 => "DOP853",
             Family::Rkn86 => "RKN 8(6)",
             Family::Dop853Pi => "DOP853, PI controller",
+            Family::Rkn1210 => "RKN 12(10)",
             Family::Verlet => "Verlet",
             Family::Yoshida4 => "Yoshida 4",
             Family::Yoshida6 => "Yoshida 6",
@@ -122,6 +126,7 @@ impl Family {
             Family::Dop853
                 | Family::Rkn86
                 | Family::Dop853Pi
+                | Family::Rkn1210
                 | Family::AveragedDop853
                 | Family::AveragedRkn86
                 | Family::AveragedRkn86Pi
@@ -164,6 +169,10 @@ impl Family {
                 atol: setting,
             },
             Family::Rkn86 | Family::AveragedRkn86 | Family::AveragedRkn86Pi => Method::Rkn86 {
+                rtol: setting,
+                atol: setting,
+            },
+            Family::Rkn1210 => Method::Rkn1210 {
                 rtol: setting,
                 atol: setting,
             },

@@ -32,6 +32,7 @@ fn colour(f: Family) -> RGBColor {
         Family::Dop853 => RGBColor(214, 39, 40),
         Family::Rkn86 => RGBColor(23, 190, 207),
         Family::Dop853Pi => RGBColor(247, 129, 191),
+        Family::Rkn1210 => RGBColor(0, 90, 160),
         Family::Verlet => RGBColor(44, 160, 44),
         Family::Yoshida4 => RGBColor(148, 103, 189),
         Family::Yoshida6 => RGBColor(140, 86, 75),

@@ -31,7 +31,7 @@ const OMEGA: f64 = 330.0;
 pub struct RealTimeFactor {
     /// `"full"` or `"averaged"`.
     pub model: &'static str,
-    /// `"dop853"` or `"rkn86"`.
+    /// `"dop853"`, `"rkn86"` or `"rkn1210"`.
     pub method: &'static str,
     /// The step controller: `"standard"` or `"pi"`.
     pub controller: &'static str,
@@ -79,14 +79,17 @@ const LADDER: [f64; 22] = [
 ];
 
 /// What is measured: (model, method, controller).
-pub const RECORDS: [(&str, &str, &str); 7] = [
+pub const RECORDS: [(&str, &str, &str); 10] = [
     ("full", "dop853", "standard"),
     ("full", "dop853", "pi"),
     ("full", "rkn86", "standard"),
+    ("full", "rkn1210", "standard"),
     ("averaged", "dop853", "standard"),
     ("averaged", "dop853", "pi"),
     ("averaged", "rkn86", "standard"),
     ("averaged", "rkn86", "pi"),
+    ("averaged", "rkn1210", "standard"),
+    ("averaged", "rkn1210", "pi"),
 ];
 
 /// The factors of every [`RECORDS`] entry.
@@ -104,6 +107,10 @@ pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<
         )?;
         let method = |tol: f64| match name {
             "rkn86" => Method::Rkn86 {
+                rtol: tol,
+                atol: tol,
+            },
+            "rkn1210" => Method::Rkn1210 {
                 rtol: tol,
                 atol: tol,
             },

@@ -109,6 +109,12 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> FullEom<R, D, X> {
     #[inline(always)]
     pub fn conservative_with(&self, accel: R, theta: R) -> R {
         let (s, c) = theta.sin_cos();
+        self.conservative_sc(accel, s, c)
+    }
+
+    /// The same with (sin θ, cos θ) given.
+    #[inline(always)]
+    pub fn conservative_sc(&self, accel: R, s: R, c: R) -> R {
         let s_rel = s * self.cos_d - c * self.sin_d;
         -self.omega0_sq * s + accel * s_rel
     }

@@ -13,11 +13,12 @@
 //! | [`noise`] | seeded, reproducible uniform and Gaussian noise |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
 //! | `periodic` | the full equation by RKN 8(6), a whole number of steps per drive period |
-//! | `slow` | the averaged equation by adaptive RKN 8(6), no libm sin/cos per evaluation |
+//! | `adaptive` | the full or averaged equation by an adaptive RKN pair (8(6), 12(10)), no libm sin/cos of the angle per evaluation |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
 //! | [`run`] | `simulate`: compose, integrate, sample, classify |
 
+mod adaptive;
 pub mod classify;
 pub mod eom;
 pub mod fidelity;
@@ -30,7 +31,6 @@ pub mod sampling;
 pub mod scene;
 pub mod sensor;
 pub mod signal;
-mod slow;
 mod turns;
 pub mod wobble;
 

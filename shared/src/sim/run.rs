@@ -7,6 +7,7 @@
 //! it does not list. Coulomb friction switches between sliding segments and sticking, so it has
 //! its own loop ([`super::friction`]).
 
+use super::adaptive::{self, Fast, Slow};
 use super::classify::{self, Outcome, Undecided};
 use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use super::fidelity::{self, Decision, FidelityError};
@@ -17,9 +18,9 @@ use super::sampling::{Hermite, Interpolant, Recorder, Sampler};
 use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
-use super::slow;
 use super::turns::{Shifted, Turns};
 use super::wobble::Wobble;
+use crate::integrate::rkn::{RKN1210, RKN86};
 use crate::integrate::{
     rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
     StepControl, Symplectic, System,
@@ -39,6 +40,10 @@ pub enum Method {
     /// estimate ([`super::periodic`]); on the averaged equation: an adaptive step
     /// ([`super::slow`]).
     Rkn86 { rtol: f64, atol: f64 },
+    /// Runge–Kutta–Nyström 12(10) with an adaptive step ([`super::adaptive`]), on the full or
+    /// the averaged equation, viscous damping or none: for runs whose time scale is not the
+    /// drive's (chaotic transients, a ramping drive).
+    Rkn1210 { rtol: f64, atol: f64 },
     /// A symplectic method (Störmer–Verlet or a Yoshida composition) with a fixed step of
     /// T/steps_per_period: undamped scenes only.
     Symplectic {
@@ -52,7 +57,7 @@ impl Method {
     /// controller acts on) on the given fidelity.
     pub fn has_step_controller(&self, fidelity: Fidelity) -> bool {
         match self {
-            Method::Dop853 { .. } => true,
+            Method::Dop853 { .. } | Method::Rkn1210 { .. } => true,
             Method::Rkn86 { .. } => fidelity == Fidelity::Averaged,
             Method::Rk4 { .. } | Method::Symplectic { .. } => false,
         }
@@ -185,6 +190,8 @@ impl From<IntegrateError> for SimError {
     }
 }
 
+const NOT_LINEARISED: &str = "methods rkn86 and rkn1210 integrate the full or the averaged equation: set run.fidelity = \"full\" or \"averaged\", or use dop853";
+
 /// Everything a generic run needs besides the equation.
 pub(super) struct Context {
     pub method: Method,
@@ -259,7 +266,7 @@ fn check_method(
 ) -> Result<(), SimError> {
     if options.controller != Controller::Standard && !options.method.has_step_controller(fidelity) {
         return Err(SimError::Unsupported(
-            "run.controller = \"pi\" needs a method with an adaptive step: dop853, or rkn86 on the averaged model (rk4 and the symplectic methods take fixed steps; rkn86 on the full model chooses whole steps per drive period)",
+            "run.controller = \"pi\" needs a method with an adaptive step: dop853, rkn1210, or rkn86 on the averaged model (rk4 and the symplectic methods take fixed steps; rkn86 on the full model chooses whole steps per drive period)",
         ));
     }
     let steps_ok = |spp: f64| spp > 0.0 && spp <= MAX_STEPS_PER_PERIOD;
@@ -297,6 +304,14 @@ fn check_method(
             if e.coulomb.is_some() {
                 return Err(SimError::Unsupported(
                     "method rkn86 cannot run effects.coulomb: stick–slip needs event location (use dop853)",
+                ));
+            }
+        }
+        Method::Rkn1210 { rtol, atol } => {
+            tolerances(rtol, atol)?;
+            if scene.effects.coulomb.is_some() {
+                return Err(SimError::Unsupported(
+                    "method rkn1210 cannot run effects.coulomb: stick–slip needs event location (use dop853)",
                 ));
             }
         }
@@ -435,21 +450,30 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
 ) -> Result<Report, SimError> {
     let full =
         || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
+    let averaged = || {
+        let r_eff = averaged_r(scene, p);
+        AveragedEom::<R, D, _>::new(p.omega0 * p.omega0, r_eff, scene.drive.angle, sig, NoExtra)
+    };
     let out = match (scene.effects.coulomb, ctx.method) {
         (Some(mu), _) => friction::run(full(), R::from_f64(p.c), mu, ctx, rec)?,
         (None, Method::Rkn86 { rtol, atol }) => match decision.fidelity {
             Fidelity::Full => periodic::run(full(), p.c, (rtol, atol), ctx, rec)?,
             Fidelity::Averaged => {
-                let w0sq = p.omega0 * p.omega0;
-                let r_eff = averaged_r(scene, p);
-                let eom = AveragedEom::<R, D, _>::new(w0sq, r_eff, scene.drive.angle, sig, NoExtra);
-                slow::run(eom, p.c, (rtol, atol), ctx, rec)?
+                let eom = averaged();
+                adaptive::run(Slow(&eom), &RKN86, p.c, (rtol, atol), ctx, rec)?
             }
-            Fidelity::Linearised => {
-                return Err(SimError::Unsupported(
-                    "method rkn86 integrates the full or the averaged equation: set run.fidelity = \"full\" or \"averaged\", or use dop853",
-                ))
+            Fidelity::Linearised => return Err(SimError::Unsupported(NOT_LINEARISED)),
+        },
+        (None, Method::Rkn1210 { rtol, atol }) => match decision.fidelity {
+            Fidelity::Full => {
+                let eom = full();
+                adaptive::run(Fast(&eom), &RKN1210, p.c, (rtol, atol), ctx, rec)?
             }
+            Fidelity::Averaged => {
+                let eom = averaged();
+                adaptive::run(Slow(&eom), &RKN1210, p.c, (rtol, atol), ctx, rec)?
+            }
+            Fidelity::Linearised => return Err(SimError::Unsupported(NOT_LINEARISED)),
         },
         (None, _) => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
     };
@@ -635,9 +659,9 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             let n_h = fixed_steps(ctx, steps_per_period);
             (t, y) = in_stretches(&driver, &sys, n_h, y, &mut turns, &mut sampler, &mut work);
         }
-        Method::Rkn86 { .. } => {
+        Method::Rkn86 { .. } | Method::Rkn1210 { .. } => {
             return Err(SimError::Unsupported(
-                "method rkn86 runs the full equation through its own loop",
+                "the RKN methods run through their own loops",
             ))
         }
         Method::Rk4 { steps_per_period } => {

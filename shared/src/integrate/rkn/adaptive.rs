@@ -1,25 +1,25 @@
-//! RKN 8(6) with an adaptive step, for θ'' = g(t, θ) − c θ' where no drive period sets the
-//! time scale (the averaged model's slow motion).
+//! RKN 8(6) or 12(10) with an adaptive step, for θ'' = g(t, θ) − c θ' where no drive period
+//! sets the time scale (the averaged model's slow motion, chaotic transients, a drive off).
 //!
 //! ```text
 //! error of a step  err = max(|Δθ|/(atol + rtol max(|θ0|, |θ1|)), |Δθ'|/(atol + rtol max(|θ0'|, |θ1'|)))
-//!                  Δ = order 8 − order 6 (local error O(h⁷))
+//!                  Δ = high order − embedded order q (local error O(h^(q+1)))
 //! accept iff err ≤ 1
-//! h_new = h / clamp(err^(1/7 − 0.2β) / err_prev^β / 0.9,  1/5, 1/0.2)    (β = 0: standard)
+//! h_new = h / clamp(err^(1/(q+1) − 0.2β) / err_prev^β / 0.9,  1/5, 1/0.2)    (β = 0: standard)
 //! ```
 //! After a rejection the next step may not grow. β > 0 is the PI controller (HNW I §IV.2): on
 //! an oscillation whose steps cover a sizeable part of its period the error constant changes
 //! from step to step, and the standard controller then rejects about one attempt in four;
 //! the PI controller's memory of the last error damps that.
 //!
-//! Each step builds its damping weights afresh ([`DampedRkn`]): one expm1 per step, and one
+//! Each step builds its damping weights afresh ([`Damped`]): one expm1 per step, and one
 //! log1p per stage only when g depends on t ([`Accel::autonomous`]). The state between step
 //! ends is the quintic Hermite interpolant of θ, θ', θ'' at both ends ([`Span`]), all known
 //! without an evaluation: its error is O(h⁶), below the step's own error wherever the step is
 //! small enough for tolerances of ~1e-6 or tighter, and it is used only for samples, never to
 //! continue the run.
 
-use super::DampedRkn;
+use super::{Damped, Pair, RKN86};
 use crate::integrate::{IntegrateError, Solution, Stats};
 use crate::{math, Real};
 
@@ -113,8 +113,8 @@ impl AdaptiveRkn {
         }
     }
 
-    /// Integrates θ'' = g(t, θ) − c θ' from (t0, θ0, θ0') to t1 > t0, handing every accepted
-    /// step to `on_step`, which returns true to end the run at that step's end.
+    /// Integrates θ'' = g(t, θ) − c θ' by RKN 8(6) from (t0, θ0, θ0') to t1 > t0, handing every
+    /// accepted step to `on_step`, which returns true to end the run at that step's end.
     pub fn solve<R: Real, A: Accel<R>>(
         &self,
         sys: &A,
@@ -122,8 +122,24 @@ impl AdaptiveRkn {
         t0: f64,
         y0: (R, R),
         t1: f64,
+        on_step: impl FnMut(&Span<R>) -> bool,
+    ) -> Result<Solution<(R, R)>, IntegrateError> {
+        self.solve_with(&RKN86, sys, c, t0, y0, t1, on_step)
+    }
+
+    /// [`AdaptiveRkn::solve`] with any pair (the error exponent follows its embedded order).
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_with<R: Real, A: Accel<R>, const S: usize>(
+        &self,
+        pair: &'static Pair<S>,
+        sys: &A,
+        c: f64,
+        t0: f64,
+        y0: (R, R),
+        t1: f64,
         mut on_step: impl FnMut(&Span<R>) -> bool,
     ) -> Result<Solution<(R, R)>, IntegrateError> {
+        let exponent = 1.0 / f64::from(pair.orders.1 + 1);
         let floor = crate::integrate::TOLERANCE_FLOOR * R::EPSILON.to_f64();
         let ok = |x: f64| x.is_finite() && x >= 0.0;
         if !ok(self.rtol) || !ok(self.atol) || self.rtol + self.atol == 0.0 {
@@ -161,19 +177,15 @@ impl AdaptiveRkn {
             let last = t + 1.01 * h >= t1;
             let t_new = if last { t1 } else { t + h };
             h = t_new - t;
-            let m = if sys.autonomous() {
-                DampedRkn::autonomous(h, c)
-            } else {
-                DampedRkn::new(h, c)
-            };
+            let m = Damped::of(pair, h, c, !sys.autonomous());
             let base = sys.base(t, y.0);
             let out = m.step(y.0, y.1, g0, |i, th| sys.accel(&base, t + m.tau[i], th));
-            stats.rhs_evals += 8;
+            stats.rhs_evals += S as u64 - 1;
             let err = scaled(out.error.0, y.0, out.theta).max(scaled(out.error.1, y.1, out.rate));
             if !err.is_finite() || !out.theta.is_finite() || !out.rate.is_finite() {
                 return Err(IntegrateError::NonFinite { t });
             }
-            let fac_err = math::pow_rough(err, 1.0 / 7.0 - 0.2 * self.beta);
+            let fac_err = math::pow_rough(err, exponent - 0.2 * self.beta);
             if err > 1.0 {
                 h /= (fac_err / SAFETY).min(1.0 / FAC_MIN);
                 stats.rejected += 1;
@@ -181,14 +193,20 @@ impl AdaptiveRkn {
                 continue;
             }
             stats.steps += 1;
+            let g1 = if pair.fsal {
+                out.g1
+            } else {
+                stats.rhs_evals += 1;
+                sys.accel(&sys.base(t_new, out.theta), t_new, out.theta)
+            };
             let span = Span {
                 t0: t,
                 t1: t_new,
                 y0: (y.0, y.1, g0 - cr * y.1),
-                y1: (out.theta, out.rate, out.g1 - cr * out.rate),
+                y1: (out.theta, out.rate, g1 - cr * out.rate),
             };
             let stop = on_step(&span);
-            (t, y, g0) = (t_new, (out.theta, out.rate), out.g1);
+            (t, y, g0) = (t_new, (out.theta, out.rate), g1);
             if last || stop {
                 return Ok(Solution { t, y, stats });
             }

@@ -1,22 +1,27 @@
-//! The averaged model by adaptive RKN 8(6) (`run.method = "rkn86"` on the averaged equation).
+//! The full or the averaged equation by an adaptive RKN pair ([`AdaptiveRkn`]): `run.method =
+//! "rkn86"` on the averaged equation, `"rkn1210"` on either.
 //!
 //! The averaged equation φ'' = −ω0² [sin φ + (R_eff σ(t)/2) sin 2(φ − θd)] − c φ' has no drive
-//! term, so no drive period sets its step: the step follows the slow motion alone
-//! ([`AdaptiveRkn`]), damping by the change of variable of [`crate::integrate::rkn`].
+//! term, so no drive period sets its step: the step follows the slow motion alone. The full
+//! equation by 12(10) is for runs whose time scale is not the drive's (chaotic transients, a
+//! drive off or ramping). Damping by the change of variable of [`crate::integrate::rkn`].
 //!
-//! No libm sin/cos per evaluation: a step computes sin φ0, cos φ0 once at its start, and every
-//! stage inside it, at φ0 + δ, uses the angle-addition formulas with sin δ and cos δ from their
-//! Taylor polynomials (to δ¹³ and δ¹⁴: below 3e-17 for |δ| ≤ 1/2; a larger δ, a step that
-//! turns the pendulum by more than half a radian, falls back to libm).
+//! No libm sin/cos of the angle per evaluation: a step computes sin θ0, cos θ0 once at its
+//! start, and every stage inside it, at θ0 + δ, uses the angle-addition formulas with sin δ and
+//! cos δ from their Taylor polynomials (to δ¹³ and δ¹⁴: below 3e-17 for |δ| ≤ 1/2; a larger δ,
+//! a step that turns the pendulum by more than half a radian, falls back to libm). The full
+//! equation's drive term is the drive signal's own (one cos per stage: its stage times change
+//! with every step, so no table can hold them).
 //!
 //! Samples between step ends (strobes, period means, output) come from the step's quintic
 //! Hermite interpolant ([`Span`]), without evaluations.
 
-use super::eom::{AveragedEom, NoExtra};
+use super::eom::{AveragedEom, FullEom, NoExtra};
 use super::run::{Context, RunOut, SimError};
 use super::sampling::{Interpolant, Recorder};
 use super::signal::DriveSignal;
 use super::turns::{Shifted, Turns};
+use crate::integrate::rkn::Pair;
 use crate::integrate::{Accel, AdaptiveRkn, Span, Stats};
 use crate::Real;
 
@@ -47,9 +52,21 @@ fn sin_cos_small<R: Real>(d: R) -> (R, R) {
     (sin, cos)
 }
 
+/// (sin θ, cos θ) inside a step that started at θ0 with (sin θ0, cos θ0).
+#[inline(always)]
+fn sin_cos_near<R: Real>(&(theta0, s0, c0): &(R, R, R), theta: R) -> (R, R) {
+    let d = theta - theta0;
+    if d.abs().to_f64() <= SMALL {
+        let (sd, cd) = sin_cos_small(d);
+        (s0 * cd + c0 * sd, c0 * cd - s0 * sd)
+    } else {
+        theta.sin_cos()
+    }
+}
+
 /// The averaged equation's conservative part seen by the adaptive run: damping is the
 /// integrator's.
-struct Slow<'e, R: Real, D: DriveSignal<R>>(&'e AveragedEom<R, D, NoExtra>);
+pub(super) struct Slow<'e, R: Real, D: DriveSignal<R>>(pub &'e AveragedEom<R, D, NoExtra>);
 
 impl<R: Real, D: DriveSignal<R>> Accel<R> for Slow<'_, R, D> {
     /// φ0, sin φ0, cos φ0.
@@ -66,15 +83,33 @@ impl<R: Real, D: DriveSignal<R>> Accel<R> for Slow<'_, R, D> {
     }
 
     #[inline(always)]
-    fn accel(&self, &(phi0, s0, c0): &(R, R, R), t: f64, phi: R) -> R {
-        let d = phi - phi0;
-        let (s, c) = if d.abs().to_f64() <= SMALL {
-            let (sd, cd) = sin_cos_small(d);
-            (s0 * cd + c0 * sd, c0 * cd - s0 * sd)
-        } else {
-            phi.sin_cos()
-        };
+    fn accel(&self, base: &(R, R, R), t: f64, phi: R) -> R {
+        let (s, c) = sin_cos_near(base, phi);
         self.0.conservative_sc(t, s, c)
+    }
+}
+
+/// The full equation's conservative part (gravity and drive) seen by the adaptive run.
+pub(super) struct Fast<'e, R: Real, D: DriveSignal<R>>(pub &'e FullEom<R, D, NoExtra>);
+
+impl<R: Real, D: DriveSignal<R>> Accel<R> for Fast<'_, R, D> {
+    /// θ0, sin θ0, cos θ0.
+    type Base = (R, R, R);
+
+    fn autonomous(&self) -> bool {
+        false
+    }
+
+    #[inline(always)]
+    fn base(&self, _t0: f64, theta0: R) -> (R, R, R) {
+        let (s, c) = theta0.sin_cos();
+        (theta0, s, c)
+    }
+
+    #[inline(always)]
+    fn accel(&self, base: &(R, R, R), t: f64, theta: R) -> R {
+        let (s, c) = sin_cos_near(base, theta);
+        self.0.conservative_sc(self.0.drive.accel(t), s, c)
     }
 }
 
@@ -87,9 +122,11 @@ impl<R: Real> Interpolant for Between<R> {
     }
 }
 
-/// Runs the averaged equation `eom` (no extra forces) with viscous damping c.
-pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
-    eom: AveragedEom<R, D, NoExtra>,
+/// Runs `sys` (gravity and drive of the full or averaged equation) by `pair` with viscous
+/// damping c.
+pub(super) fn run<'r, R: Real, A: Accel<R>, Rec: Recorder, const S: usize>(
+    sys: A,
+    pair: &'static Pair<S>,
     c: f64,
     (rtol, atol): (f64, f64),
     ctx: &Context,
@@ -99,14 +136,13 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     let mut turns = Turns::new(ctx.periodic);
     let mut solver = AdaptiveRkn::new(rtol, atol);
     solver.beta = ctx.beta;
-    let sys = Slow(&eom);
     let mut y = (turns.reduce(R::from_f64(ctx.y0.0)), R::from_f64(ctx.y0.1));
     let mut t = 0.0;
     let mut work = Stats::default();
     while t < ctx.t_end {
         let offset = turns.offset();
         let mut last_h = None;
-        let sol = solver.solve(&sys, c, t, y, ctx.t_end, |span| {
+        let sol = solver.solve_with(pair, &sys, c, t, y, ctx.t_end, |span| {
             let end = (span.y1.0.to_f64() + offset, span.y1.1.to_f64());
             sampler.step(span.t1, end, &mut Shifted(Between(*span), offset));
             last_h = Some(span.t1 - span.t0);
