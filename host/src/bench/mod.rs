@@ -484,7 +484,7 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
 
     let chaotic_fate = match scenes.iter().find(|s| s.name == "chaotic") {
         Some(s) => physical::chaotic_fate(&s.shipped, &plan.fate_tolerances, || {
-            progress.tick("chaotic scene as shipped")
+            progress.tick("chaotic scene over 4000 periods")
         })?,
         None => Vec::new(),
     };

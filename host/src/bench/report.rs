@@ -563,7 +563,8 @@ pub fn markdown(r: &Results, command: &str) -> String {
     if !r.chaotic_fate.is_empty() {
         let _ = writeln!(
             s,
-            "\nThe chaotic scene as shipped (4000 drive periods), DOP853 f64 at each tolerance:\n"
+            "\nThe chaotic scene as shipped but over {} drive periods, DOP853 f64 at each tolerance:\n",
+            super::physical::FATE_PERIODS
         );
         let _ = writeln!(s, "| tolerance | outcome |");
         let _ = writeln!(s, "|---|---|");
