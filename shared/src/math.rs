@@ -59,7 +59,7 @@ pub fn powf(x: f64, y: f64) -> f64 {
 /// gives 0; x is clamped to [1e-300, 1e300].
 #[inline]
 pub fn pow_rough(x: f64, y: f64) -> f64 {
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 0.0;
     }
     let x = x.clamp(1e-300, 1e300);

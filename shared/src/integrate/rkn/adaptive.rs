@@ -145,13 +145,14 @@ impl AdaptiveRkn {
         if !ok(self.rtol) || !ok(self.atol) || self.rtol + self.atol == 0.0 {
             return Err(IntegrateError::BadTolerance);
         }
-        if !(self.beta.is_finite() && (0.0..=0.2).contains(&self.beta)) || !(self.h_max > 0.0) {
+        let beta_ok = self.beta.is_finite() && (0.0..=0.2).contains(&self.beta);
+        if !beta_ok || self.h_max.is_nan() || self.h_max <= 0.0 {
             return Err(IntegrateError::BadTolerance);
         }
         let (rtol, atol) = (self.rtol.max(floor), self.atol.max(floor));
         let mut stats = Stats::default();
         let (mut t, mut y) = (t0, y0);
-        if !(t1 > t0) || !y.0.is_finite() || !y.1.is_finite() {
+        if t1.is_nan() || t1 <= t0 || !y.0.is_finite() || !y.1.is_finite() {
             return Ok(Solution { t, y, stats });
         }
         let mut g0 = sys.accel(&sys.base(t, y.0), t, y.0);

@@ -166,9 +166,9 @@ impl<const S: usize> Damped<S> {
         let mut raw_last = g0;
         for i in 1..S {
             let mut acc = R::ZERO;
-            for j in 0..i {
-                if p.a[i][j] != 0.0 {
-                    acc += R::from_f64(p.a[i][j]) * k[j];
+            for (&a, &kj) in p.a[i].iter().zip(&k).take(i) {
+                if a != 0.0 {
+                    acc += R::from_f64(a) * kj;
                 }
             }
             let y = theta + R::from_f64(p.c[i]) * s * rate + s2 * acc;
@@ -176,11 +176,11 @@ impl<const S: usize> Damped<S> {
             k[i] = R::from_f64(self.weight[i]) * raw_last;
         }
         let (mut ph, mut vh, mut pl, mut vl) = (R::ZERO, R::ZERO, R::ZERO, R::ZERO);
-        for i in 0..S {
-            ph += R::from_f64(p.bbar[i]) * k[i];
-            vh += R::from_f64(p.b[i]) * k[i];
-            pl += R::from_f64(p.bbar_low[i]) * k[i];
-            vl += R::from_f64(p.b_low[i]) * k[i];
+        for (i, &ki) in k.iter().enumerate() {
+            ph += R::from_f64(p.bbar[i]) * ki;
+            vh += R::from_f64(p.b[i]) * ki;
+            pl += R::from_f64(p.bbar_low[i]) * ki;
+            vl += R::from_f64(p.b_low[i]) * ki;
         }
         let decay = R::from_f64(self.decay);
         RknStep {
