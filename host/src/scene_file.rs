@@ -21,7 +21,7 @@ use kapitza_core::model::{DriveAngle, Geometry};
 use kapitza_core::sim::scene::{
     DriveFrequency, DriveSpec, Effects, Fidelity, FidelityChoice, RunLength, Sensor, Viscous,
 };
-use kapitza_core::sim::{fidelity, Format, Method, Scene};
+use kapitza_core::sim::{fidelity, Controller, Format, Method, Scene};
 use kapitza_core::ParamError;
 
 /// RK4 steps per drive period when `run.steps_per_period` is not given.
@@ -34,6 +34,8 @@ pub struct SceneFile {
     pub title: String,
     pub scene: Scene,
     pub method: Method,
+    /// The adaptive method's step controller (`run.controller`).
+    pub controller: Controller,
     pub format: Format,
     /// Seed of the sensor noise.
     pub seed: u64,
@@ -233,10 +235,19 @@ enum MethodName {
     Auto,
     Dop853,
     Rkn86,
+    Rkn1210,
     Rk4,
     Verlet,
     Yoshida4,
     Yoshida6,
+}
+
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum ControllerName {
+    #[default]
+    Standard,
+    Pi,
 }
 
 #[derive(Debug, Clone, Copy, Default, Deserialize)]
@@ -259,6 +270,8 @@ struct RawRun {
     rtol: Option<f64>,
     atol: Option<f64>,
     steps_per_period: Option<f64>,
+    #[serde(default)]
+    controller: ControllerName,
     #[serde(default)]
     format: FormatName,
     seed: Option<u64>,
@@ -431,10 +444,19 @@ fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     if matches!(method, Method::Symplectic { .. }) && p.c > 0.0 {
         bail!("run.method: symplectic methods integrate undamped motion only: remove effects.viscous, or use \"dop853\" or \"rk4\"");
     }
+    let controller = match run.controller {
+        ControllerName::Standard => Controller::Standard,
+        ControllerName::Pi => Controller::Pi,
+    };
+    let decided = fidelity::decide(&scene, &p).map_err(|e| anyhow!("{e}"))?;
+    if controller == Controller::Pi && !method.has_step_controller(decided.fidelity) {
+        bail!("run.controller = \"pi\" needs a method with an adaptive step: allowed with \"dop853\" (or \"auto\"), \"rkn1210\", or \"rkn86\" on the averaged model (fixed-step methods have no step controller; rkn86 on the full model chooses whole steps per drive period)");
+    }
     Ok(SceneFile {
         title: raw.title.unwrap_or_else(|| stem.to_string()),
         scene,
         method,
+        controller,
         format: match run.format {
             FormatName::F64 => Format::F64,
             FormatName::F32 => Format::F32,
@@ -551,7 +573,7 @@ fn method(run: &RawRun) -> Result<Method> {
     let fixed_step = |name: &str| -> Result<f64> {
         for (key, v) in [("rtol", run.rtol), ("atol", run.atol)] {
             if let Some(v) = v {
-                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\" and \"rkn86\")");
+                bail!("run.{key} = {v} is not allowed with method = \"{name}\": allowed steps_per_period (rtol and atol are for \"dop853\", \"rkn86\" and \"rkn1210\")");
             }
         }
         run.steps_per_period.map_or(Ok(DEFAULT_RK4_STEPS), |s| {
@@ -571,7 +593,7 @@ fn method(run: &RawRun) -> Result<Method> {
         MethodName::Verlet => symplectic(Symplectic::Verlet, "verlet"),
         MethodName::Yoshida4 => symplectic(Symplectic::Yoshida4, "yoshida4"),
         MethodName::Yoshida6 => symplectic(Symplectic::Yoshida6, "yoshida6"),
-        MethodName::Auto | MethodName::Dop853 | MethodName::Rkn86 => {
+        MethodName::Auto | MethodName::Dop853 | MethodName::Rkn86 | MethodName::Rkn1210 => {
             if let Some(s) = run.steps_per_period {
                 bail!("run.steps_per_period = {s} is not allowed with an adaptive method: allowed only with a fixed-step method (rk4, verlet, yoshida4, yoshida6)");
             }
@@ -582,6 +604,7 @@ fn method(run: &RawRun) -> Result<Method> {
             let atol = run.atol.map_or(Ok(atol), |v| positive("run.atol", v))?;
             Ok(match run.method {
                 MethodName::Rkn86 => Method::Rkn86 { rtol, atol },
+                MethodName::Rkn1210 => Method::Rkn1210 { rtol, atol },
                 _ => Method::Dop853 { rtol, atol },
             })
         }

@@ -52,6 +52,41 @@ pub fn powf(x: f64, y: f64) -> f64 {
     libm::pow(x, y)
 }
 
+/// x^y for x > 0 and |y| ≤ 1 to a relative error below 1e-5, at a fraction of [`powf`]'s cost:
+/// what a step-size controller needs, whose factor is a guess to a few per cent anyway. The
+/// exponent bits give ⌊log2 x⌋; ln of the mantissa m ∈ [1, 2) comes from the series
+/// 2 atanh((m−1)/(m+1)) to the 11th power, 2^f for f ∈ [0, 1) from e^(f ln 2) to the 8th. x ≤ 0
+/// gives 0; x is clamped to [1e-300, 1e300].
+#[inline]
+pub fn pow_rough(x: f64, y: f64) -> f64 {
+    if x.is_nan() || x <= 0.0 {
+        return 0.0;
+    }
+    let x = x.clamp(1e-300, 1e300);
+    let bits = x.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    let t = (m - 1.0) / (m + 1.0);
+    let t2 = t * t;
+    let ln_m = 2.0
+        * t
+        * (1.0
+            + t2 * (1.0 / 3.0
+                + t2 * (1.0 / 5.0 + t2 * (1.0 / 7.0 + t2 * (1.0 / 9.0 + t2 / 11.0)))));
+    let z = y * (exponent as f64 + ln_m * core::f64::consts::LOG2_E);
+    let n = libm::floor(z);
+    let f = (z - n) * core::f64::consts::LN_2;
+    let two_f = 1.0
+        + f * (1.0
+            + f * (0.5
+                + f * (1.0 / 6.0
+                    + f * (1.0 / 24.0
+                        + f * (1.0 / 120.0
+                            + f * (1.0 / 720.0 + f * (1.0 / 5040.0 + f / 40320.0)))))));
+    // |z| ≤ 997 for |y| ≤ 1: 2^n is a normal number.
+    two_f * f64::from_bits(((n as i64 + 1023) as u64) << 52)
+}
+
 /// Wraps an angle to (−π, π].
 pub fn wrap_pi(x: f64) -> f64 {
     let r = libm::remainder(x, TAU); // in [−π, π]
@@ -124,6 +159,22 @@ pub fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, fa: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pow_rough_is_within_1e5_of_libm() {
+        // Against libm::pow over the controllers' range: x from 1e-299 to 1e299, y in [−1, 1].
+        for i in -299..=298 {
+            let x = 10f64.powi(i) * 1.37;
+            for y in [-1.0, -0.2, -0.04, 0.0, 0.008, 1.0 / 7.0, 0.125, 0.5, 1.0] {
+                let (got, want) = (pow_rough(x, y), libm::pow(x, y));
+                assert!(
+                    (got / want - 1.0).abs() < 1e-5,
+                    "{x:e}^{y}: {got:e} vs {want:e}"
+                );
+            }
+        }
+        assert_eq!(pow_rough(0.0, 0.5), 0.0);
+    }
 
     #[test]
     fn wrap_is_half_open() {

@@ -91,8 +91,8 @@ fn errors_fall_as_evaluations_rise() {
         if format == "f32" {
             floor = floor.max(10.0 * least(&|p| p["format"] == "f32"));
         }
-        if family == "averaged-dop853" {
-            floor = floor.max(10.0 * least(&|p| p["family"] == "averaged-dop853"));
+        if family.starts_with("averaged-") {
+            floor = floor.max(10.0 * least(&|p| p["fidelity"] == "averaged"));
         }
         for (i, a) in curve.iter().enumerate() {
             for b in &curve[i + 1..] {

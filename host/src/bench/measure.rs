@@ -19,7 +19,7 @@ use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::sim::sampling::Discard;
 use kapitza_core::sim::scene::Fidelity;
-use kapitza_core::sim::{simulate, Format, Method, Options, Report, Scene};
+use kapitza_core::sim::{simulate, Controller, Format, Method, Options, Report, Scene};
 
 /// Reference tolerance: DOP853 at rtol = atol = 1e-13 (f64).
 pub const REFERENCE_TOL: f64 = 1e-13;
@@ -36,6 +36,10 @@ pub enum Family {
     Dop853,
     /// Our RKN 8(6), a whole number of steps per drive period; setting: rtol = atol.
     Rkn86,
+    /// Our DOP853 with the PI step controller (`run.controller = "pi"`); setting: rtol = atol.
+    Dop853Pi,
+    /// Our adaptive RKN 12(10); setting: rtol = atol.
+    Rkn1210,
     /// Störmer–Verlet; setting: steps per drive period.
     Verlet,
     /// Yoshida's 4th-order composition; setting: steps per drive period.
@@ -44,6 +48,10 @@ pub enum Family {
     Yoshida6,
     /// The averaged model integrated by our DOP853; setting: rtol = atol.
     AveragedDop853,
+    /// The averaged model by our adaptive RKN 8(6); setting: rtol = atol.
+    AveragedRkn86,
+    /// The same with the PI step controller; setting: rtol = atol.
+    AveragedRkn86Pi,
     /// The peer: `ode_solvers::Dopri5`; setting: rtol = atol.
     PeerDopri5,
     /// The peer: `ode_solvers::Dop853` as published; setting: rtol = atol.
@@ -58,10 +66,14 @@ impl Family {
             Family::Rk4 => "rk4",
             Family::Dop853 => "dop853",
             Family::Rkn86 => "rkn86",
+            Family::Dop853Pi => "dop853-pi",
+            Family::Rkn1210 => "rkn1210",
             Family::Verlet => "verlet",
             Family::Yoshida4 => "yoshida4",
             Family::Yoshida6 => "yoshida6",
             Family::AveragedDop853 => "averaged-dop853",
+            Family::AveragedRkn86 => "averaged-rkn86",
+            Family::AveragedRkn86Pi => "averaged-rkn86-pi",
             Family::PeerDopri5 => "peer-dopri5",
             Family::PeerDop853 => "peer-dop853",
             Family::PeerDop853Autonomous => "peer-dop853-autonomous",
@@ -74,10 +86,14 @@ impl Family {
             Family::Rk4 => "RK4",
             Family::Dop853 => "DOP853",
             Family::Rkn86 => "RKN 8(6)",
+            Family::Dop853Pi => "DOP853, PI controller",
+            Family::Rkn1210 => "RKN 12(10)",
             Family::Verlet => "Verlet",
             Family::Yoshida4 => "Yoshida 4",
             Family::Yoshida6 => "Yoshida 6",
             Family::AveragedDop853 => "averaged model, DOP853",
+            Family::AveragedRkn86 => "averaged model, RKN 8(6)",
+            Family::AveragedRkn86Pi => "averaged model, RKN 8(6), PI controller",
             Family::PeerDopri5 => "ode_solvers Dopri5",
             Family::PeerDop853 => "ode_solvers Dop853 as published",
             Family::PeerDop853Autonomous => "ode_solvers Dop853, t as state",
@@ -93,7 +109,15 @@ impl Family {
 
     /// The full equation (everything but the averaged model).
     pub fn is_full_model(self) -> bool {
-        self != Family::AveragedDop853
+        self.fidelity() == Fidelity::Full
+    }
+
+    /// The step controller of our adaptive methods.
+    pub fn controller(self) -> Controller {
+        match self {
+            Family::Dop853Pi | Family::AveragedRkn86Pi => Controller::Pi,
+            _ => Controller::Standard,
+        }
     }
 
     pub fn adaptive(self) -> bool {
@@ -101,7 +125,11 @@ impl Family {
             self,
             Family::Dop853
                 | Family::Rkn86
+                | Family::Dop853Pi
+                | Family::Rkn1210
                 | Family::AveragedDop853
+                | Family::AveragedRkn86
+                | Family::AveragedRkn86Pi
                 | Family::PeerDopri5
                 | Family::PeerDop853
                 | Family::PeerDop853Autonomous
@@ -118,10 +146,11 @@ impl Family {
     }
 
     pub fn fidelity(self) -> Fidelity {
-        if self == Family::AveragedDop853 {
-            Fidelity::Averaged
-        } else {
-            Fidelity::Full
+        match self {
+            Family::AveragedDop853 | Family::AveragedRkn86 | Family::AveragedRkn86Pi => {
+                Fidelity::Averaged
+            }
+            _ => Fidelity::Full,
         }
     }
 
@@ -135,11 +164,15 @@ impl Family {
             Family::Rk4 => Method::Rk4 {
                 steps_per_period: setting,
             },
-            Family::Dop853 | Family::AveragedDop853 => Method::Dop853 {
+            Family::Dop853 | Family::Dop853Pi | Family::AveragedDop853 => Method::Dop853 {
                 rtol: setting,
                 atol: setting,
             },
-            Family::Rkn86 => Method::Rkn86 {
+            Family::Rkn86 | Family::AveragedRkn86 | Family::AveragedRkn86Pi => Method::Rkn86 {
+                rtol: setting,
+                atol: setting,
+            },
+            Family::Rkn1210 => Method::Rkn1210 {
                 rtol: setting,
                 atol: setting,
             },
@@ -209,15 +242,28 @@ pub fn options(method: Method, format: Format, classify: bool) -> Options {
     Options {
         method,
         format,
-        out_dt: 0.0,
-        seed: 1,
         classify,
+        ..Options::default()
     }
 }
 
 /// One unclassified run.
 pub fn run(scene: &Scene, method: Method, format: Format) -> Result<Report> {
-    simulate(scene, &options(method, format, false), &mut Discard).map_err(|e| anyhow!("{e}"))
+    run_with(scene, method, Controller::Standard, format)
+}
+
+/// One unclassified run with the given step controller.
+pub fn run_with(
+    scene: &Scene,
+    method: Method,
+    controller: Controller,
+    format: Format,
+) -> Result<Report> {
+    let options = Options {
+        controller,
+        ..options(method, format, false)
+    };
+    simulate(scene, &options, &mut Discard).map_err(|e| anyhow!("{e}"))
 }
 
 fn end_of(r: &Report) -> (f64, f64) {
@@ -267,12 +313,13 @@ pub fn ours(job: &Job, batch: Duration) -> Result<Point> {
         .ok_or_else(|| anyhow!("{} is not one of ours", job.family.name()))?;
     let scene = job.scene.with_fidelity(job.family.fidelity());
     let omega = scene.physical()?.omega;
-    let r = run(&scene, method, job.format)?;
+    let controller = job.family.controller();
+    let r = run_with(&scene, method, controller, job.format)?;
     let err = error(end_of(&r), (job.reference.theta, job.reference.rate), omega);
     if !err.is_finite() {
         return Err(anyhow!("the end state is not finite"));
     }
-    let cost = clock::cost(batch, || run(&scene, method, job.format));
+    let cost = clock::cost(batch, || run_with(&scene, method, controller, job.format));
     Ok(Point {
         scene: job.scene.name.to_string(),
         family: job.family,

@@ -18,7 +18,7 @@ use std::time::Duration;
 use super::clock;
 use kapitza_core::math;
 use kapitza_core::sim::sampling::Discard;
-use kapitza_core::sim::{simulate, Method, Options, Scene};
+use kapitza_core::sim::{simulate, Controller, Method, Options, Scene};
 
 /// Simulated time (s).
 pub const SIMULATED: f64 = 60.0;
@@ -31,8 +31,10 @@ const OMEGA: f64 = 330.0;
 pub struct RealTimeFactor {
     /// `"full"` or `"averaged"`.
     pub model: &'static str,
-    /// `"dop853"` or `"rkn86"`.
+    /// `"dop853"`, `"rkn86"` or `"rkn1210"`.
     pub method: &'static str,
+    /// The step controller: `"standard"` or `"pi"`.
+    pub controller: &'static str,
     /// rtol = atol of the cheapest setting that reaches [`TARGET`].
     pub setting: f64,
     /// Its final error against the model's reference.
@@ -59,9 +61,10 @@ fn scene(fidelity: &str) -> Result<Scene> {
 
 const TILTED: &str = include_str!("../../../scenes/tilted-135.toml");
 
-fn end(s: &Scene, method: Method) -> Result<(f64, f64)> {
+fn end(s: &Scene, method: Method, controller: Controller) -> Result<(f64, f64)> {
     let options = Options {
         method,
+        controller,
         classify: false,
         ..Options::default()
     };
@@ -75,14 +78,24 @@ const LADDER: [f64; 22] = [
     5e-8, 2e-8, 1e-8, 5e-9, 2e-9, 1e-9,
 ];
 
-/// The factors of DOP853 and RKN 8(6) on the full model and of DOP853 on the averaged one.
+/// What is measured: (model, method, controller).
+pub const RECORDS: [(&str, &str, &str); 10] = [
+    ("full", "dop853", "standard"),
+    ("full", "dop853", "pi"),
+    ("full", "rkn86", "standard"),
+    ("full", "rkn1210", "standard"),
+    ("averaged", "dop853", "standard"),
+    ("averaged", "dop853", "pi"),
+    ("averaged", "rkn86", "standard"),
+    ("averaged", "rkn86", "pi"),
+    ("averaged", "rkn1210", "standard"),
+    ("averaged", "rkn1210", "pi"),
+];
+
+/// The factors of every [`RECORDS`] entry.
 pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<RealTimeFactor>> {
     let mut out = Vec::new();
-    for (model, name) in [
-        ("full", "dop853"),
-        ("full", "rkn86"),
-        ("averaged", "dop853"),
-    ] {
+    for (model, name, controller_name) in RECORDS {
         let s = scene(model)?;
         let reference = end(
             &s,
@@ -90,9 +103,14 @@ pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<
                 rtol: 1e-13,
                 atol: 1e-13,
             },
+            Controller::Standard,
         )?;
         let method = |tol: f64| match name {
             "rkn86" => Method::Rkn86 {
+                rtol: tol,
+                atol: tol,
+            },
+            "rkn1210" => Method::Rkn1210 {
                 rtol: tol,
                 atol: tol,
             },
@@ -101,9 +119,14 @@ pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<
                 atol: tol,
             },
         };
+        let controller = if controller_name == "pi" {
+            Controller::Pi
+        } else {
+            Controller::Standard
+        };
         let mut found = None;
         for tol in LADDER {
-            let got = end(&s, method(tol))?;
+            let got = end(&s, method(tol), controller)?;
             let error = math::wrap_pi(got.0 - reference.0)
                 .abs()
                 .max((got.1 - reference.1).abs() / OMEGA);
@@ -112,12 +135,14 @@ pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<
                 break;
             }
         }
-        let (tol, error) = found
-            .ok_or_else(|| anyhow!("{model} {name}: no tolerance down to 1e-9 reaches 1e-6"))?;
-        let cost = clock::cost(batch, || end(&s, method(tol)));
+        let (tol, error) = found.ok_or_else(|| {
+            anyhow!("{model} {name} {controller_name}: no tolerance down to 1e-9 reaches 1e-6")
+        })?;
+        let cost = clock::cost(batch, || end(&s, method(tol), controller));
         out.push(RealTimeFactor {
             model,
             method: name,
+            controller: controller_name,
             setting: tol,
             error,
             cpu_s: cost.cpu_s,

@@ -286,15 +286,16 @@ pub fn realtime_table(r: &Results) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| model | method | rtol = atol | final error | CPU per 60 s run | real-time factor |"
+        "| model | method | controller | rtol = atol | final error | CPU per 60 s run | real-time factor |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
     for f in &r.real_time_factors {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             f.model,
             f.method,
+            f.controller,
             sci(f.setting),
             sci(f.error),
             secs(f.cpu_s),
@@ -562,7 +563,8 @@ pub fn markdown(r: &Results, command: &str) -> String {
     if !r.chaotic_fate.is_empty() {
         let _ = writeln!(
             s,
-            "\nThe chaotic scene as shipped (4000 drive periods), DOP853 f64 at each tolerance:\n"
+            "\nThe chaotic scene as shipped but over {} drive periods, DOP853 f64 at each tolerance:\n",
+            super::physical::FATE_PERIODS
         );
         let _ = writeln!(s, "| tolerance | outcome |");
         let _ = writeln!(s, "|---|---|");

@@ -151,6 +151,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     };
     let options = Options {
         method: file.method,
+        controller: file.controller,
         format: file.format,
         out_dt,
         seed: file.seed,
@@ -208,6 +209,7 @@ fn summarise(
     let (method, rtol, atol, steps_per_period) = match file.method {
         Method::Dop853 { rtol, atol } => ("dop853", Some(rtol), Some(atol), None),
         Method::Rkn86 { rtol, atol } => ("rkn86", Some(rtol), Some(atol), None),
+        Method::Rkn1210 { rtol, atol } => ("rkn1210", Some(rtol), Some(atol), None),
         Method::Rk4 { steps_per_period } => ("rk4", None, None, Some(steps_per_period)),
         Method::Symplectic {
             scheme,
@@ -304,6 +306,7 @@ fn print_summary(s: &Summary, report: &Report, out: &mut dyn Write) -> Result<()
     let name = match s.method {
         "dop853" => "DOP853",
         "rkn86" => "RKN 8(6)",
+        "rkn1210" => "RKN 12(10)",
         "rk4" => "RK4",
         other => other,
     };

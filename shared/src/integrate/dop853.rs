@@ -233,7 +233,7 @@ impl Dop853 {
             let fac_err = if self.beta == 0.0 {
                 math::sqrt(math::sqrt(math::sqrt(err)))
             } else {
-                math::powf(err, 0.125 - 0.2 * self.beta)
+                math::pow_rough(err, 0.125 - 0.2 * self.beta)
             };
             if err > 1.0 {
                 // Rejected: shrink (never by more than FAC_MIN) and retry.
@@ -274,7 +274,7 @@ impl Dop853 {
             let memory = if self.beta == 0.0 {
                 1.0
             } else {
-                math::powf(err_prev, self.beta)
+                math::pow_rough(err_prev, self.beta)
             };
             let fac = (fac_err / memory / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
             let mut h_new = (h.abs() / fac).min(h_max);

@@ -25,6 +25,7 @@ pub(crate) use dop853::TOLERANCE_FLOOR;
 pub use dop853::{Dop853, IntegrateError, Step, StepControl};
 pub use fixed::Control;
 pub use rk4::{rk4_fixed, rk4_observe, rk4_step};
+pub use rkn::adaptive::{Accel, AdaptiveRkn, Span};
 pub use rkn::{DampedRkn, RknStep};
 pub use symplectic::{symplectic_fixed, Force, Phase, Symplectic};
 

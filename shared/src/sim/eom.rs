@@ -109,6 +109,12 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> FullEom<R, D, X> {
     #[inline(always)]
     pub fn conservative_with(&self, accel: R, theta: R) -> R {
         let (s, c) = theta.sin_cos();
+        self.conservative_sc(accel, s, c)
+    }
+
+    /// The same with (sin θ, cos θ) given.
+    #[inline(always)]
+    pub fn conservative_sc(&self, accel: R, s: R, c: R) -> R {
         let s_rel = s * self.cos_d - c * self.sin_d;
         -self.omega0_sq * s + accel * s_rel
     }
@@ -147,17 +153,28 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
     }
 }
 
-impl<R: Real, D: DriveSignal<R>, X: Extra<R>> System<2, R> for AveragedEom<R, D, X> {
+impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
+    pub fn drive(&self) -> &D {
+        &self.drive
+    }
+
+    /// Gravity and the averaged drive force at t, given (sin φ, cos φ).
     #[inline(always)]
-    fn rhs(&self, t: f64, y: &[R; 2], dy: &mut [R; 2]) {
-        let (s, c) = y[0].sin_cos();
+    pub fn conservative_sc(&self, t: f64, s: R, c: R) -> R {
         let s_rel = s * self.cos_d - c * self.sin_d;
         let c_rel = c * self.cos_d + s * self.sin_d;
         let two = R::ONE + R::ONE;
         // sin 2(φ − θd) = 2 sin(φ − θd) cos(φ − θd)
-        let acc = -self.omega0_sq * s - self.half_r * self.drive.strength(t) * two * s_rel * c_rel;
+        -self.omega0_sq * s - self.half_r * self.drive.strength(t) * two * s_rel * c_rel
+    }
+}
+
+impl<R: Real, D: DriveSignal<R>, X: Extra<R>> System<2, R> for AveragedEom<R, D, X> {
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &[R; 2], dy: &mut [R; 2]) {
+        let (s, c) = y[0].sin_cos();
         dy[0] = y[1];
-        dy[1] = self.extra.apply(acc, y[1]);
+        dy[1] = self.extra.apply(self.conservative_sc(t, s, c), y[1]);
     }
 }
 

@@ -13,10 +13,12 @@
 //! | [`noise`] | seeded, reproducible uniform and Gaussian noise |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
 //! | `periodic` | the full equation by RKN 8(6), a whole number of steps per drive period |
+//! | `adaptive` | the full or averaged equation by an adaptive RKN pair (8(6), 12(10)), no libm sin/cos of the angle per evaluation |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
 //! | [`run`] | `simulate`: compose, integrate, sample, classify |
 
+mod adaptive;
 pub mod classify;
 pub mod eom;
 pub mod fidelity;
@@ -33,6 +35,6 @@ mod turns;
 pub mod wobble;
 
 pub use classify::Outcome;
-pub use run::{simulate, Format, Method, Options, Report, SimError};
+pub use run::{simulate, Controller, Format, Method, Options, Report, SimError};
 pub use sampling::Recorder;
 pub use scene::Scene;

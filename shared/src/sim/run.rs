@@ -7,6 +7,7 @@
 //! it does not list. Coulomb friction switches between sliding segments and sticking, so it has
 //! its own loop ([`super::friction`]).
 
+use super::adaptive::{self, Fast, Slow};
 use super::classify::{self, Outcome, Undecided};
 use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use super::fidelity::{self, Decision, FidelityError};
@@ -19,6 +20,7 @@ use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
 use super::turns::{Shifted, Turns};
 use super::wobble::Wobble;
+use crate::integrate::rkn::{RKN1210, RKN86};
 use crate::integrate::{
     rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
     StepControl, Symplectic, System,
@@ -33,10 +35,15 @@ pub enum Method {
     Rk4 { steps_per_period: f64 },
     /// Adaptive Dormand–Prince 8(5,3) with dense output.
     Dop853 { rtol: f64, atol: f64 },
-    /// Runge–Kutta–Nyström 8(6) with a whole number of steps per drive period, chosen per
-    /// period from its error estimate ([`super::periodic`]): the full equation with a drive
-    /// periodic from t = 0, and viscous damping or none.
+    /// Runge–Kutta–Nyström 8(6), viscous damping or none. On the full equation (drive periodic
+    /// from t = 0): a whole number of steps per drive period, chosen per period from its error
+    /// estimate ([`super::periodic`]); on the averaged equation: an adaptive step
+    /// ([`super::slow`]).
     Rkn86 { rtol: f64, atol: f64 },
+    /// Runge–Kutta–Nyström 12(10) with an adaptive step ([`super::adaptive`]), on the full or
+    /// the averaged equation, viscous damping or none: for runs whose time scale is not the
+    /// drive's (chaotic transients, a ramping drive).
+    Rkn1210 { rtol: f64, atol: f64 },
     /// A symplectic method (Störmer–Verlet or a Yoshida composition) with a fixed step of
     /// T/steps_per_period: undamped scenes only.
     Symplectic {
@@ -46,11 +53,43 @@ pub enum Method {
 }
 
 impl Method {
+    /// Whether the method adapts its step to an error estimate step by step (what a step
+    /// controller acts on) on the given fidelity.
+    pub fn has_step_controller(&self, fidelity: Fidelity) -> bool {
+        match self {
+            Method::Dop853 { .. } | Method::Rkn1210 { .. } => true,
+            Method::Rkn86 { .. } => fidelity == Fidelity::Averaged,
+            Method::Rk4 { .. } | Method::Symplectic { .. } => false,
+        }
+    }
+
     /// The default: DOP853 at rtol = atol = 1e-9.
     pub const DEFAULT: Method = Method::Dop853 {
         rtol: 1e-9,
         atol: 1e-9,
     };
+}
+
+/// How an adaptive method picks its next step from its error estimates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Controller {
+    /// From the last error alone (h ∝ err^(−1/(q+1))).
+    #[default]
+    Standard,
+    /// Proportional–integral: the last two errors, β = [`Controller::PI_BETA`] (HNW I §IV.2).
+    Pi,
+}
+
+impl Controller {
+    /// The PI controller's β: the value HNW recommend for explicit Runge–Kutta pairs.
+    pub const PI_BETA: f64 = 0.04;
+
+    pub fn beta(self) -> f64 {
+        match self {
+            Controller::Standard => 0.0,
+            Controller::Pi => Self::PI_BETA,
+        }
+    }
 }
 
 /// The number format of the state and its arithmetic.
@@ -64,6 +103,9 @@ pub enum Format {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
     pub method: Method,
+    /// The step controller of an adaptive method; [`Controller::Pi`] is refused for methods
+    /// without one ([`Method::has_step_controller`]).
+    pub controller: Controller,
     pub format: Format,
     /// Output sample interval (s); 0 for none.
     pub out_dt: f64,
@@ -79,6 +121,7 @@ impl Default for Options {
     fn default() -> Self {
         Self {
             method: Method::DEFAULT,
+            controller: Controller::Standard,
             format: Format::F64,
             out_dt: 0.0,
             seed: 1,
@@ -147,6 +190,8 @@ impl From<IntegrateError> for SimError {
     }
 }
 
+const NOT_LINEARISED: &str = "methods rkn86 and rkn1210 integrate the full or the averaged equation: set run.fidelity = \"full\" or \"averaged\", or use dop853";
+
 /// Everything a generic run needs besides the equation.
 pub(super) struct Context {
     pub method: Method,
@@ -168,6 +213,8 @@ pub(super) struct Context {
     /// averaged equation has no drive term to miss and its strobes and period means come from
     /// the dense output, so its step is limited by its error estimate alone.
     pub h_max: f64,
+    /// β of the adaptive methods' step controller (0: standard).
+    pub beta: f64,
 }
 
 impl Context {
@@ -204,14 +251,24 @@ pub fn simulate<Rec: Recorder>(
     scene.check()?;
     let p = scene.physical()?;
     let decision = fidelity::decide(scene, &p)?;
-    check_method(scene, &p, options)?;
+    check_method(scene, &p, decision.fidelity, options)?;
     match options.format {
         Format::F64 => run_format::<f64, Rec>(scene, &p, decision, options, rec),
         Format::F32 => run_format::<f32, Rec>(scene, &p, decision, options, rec),
     }
 }
 
-fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), SimError> {
+fn check_method(
+    scene: &Scene,
+    p: &Physical,
+    fidelity: Fidelity,
+    options: &Options,
+) -> Result<(), SimError> {
+    if options.controller != Controller::Standard && !options.method.has_step_controller(fidelity) {
+        return Err(SimError::Unsupported(
+            "run.controller = \"pi\" needs a method with an adaptive step: dop853, rkn1210, or rkn86 on the averaged model (rk4 and the symplectic methods take fixed steps; rkn86 on the full model chooses whole steps per drive period)",
+        ));
+    }
     let steps_ok = |spp: f64| spp > 0.0 && spp <= MAX_STEPS_PER_PERIOD;
     match options.method {
         Method::Symplectic {
@@ -239,14 +296,22 @@ fn check_method(scene: &Scene, p: &Physical, options: &Options) -> Result<(), Si
         Method::Rkn86 { rtol, atol } => {
             tolerances(rtol, atol)?;
             let e = &scene.effects;
-            if e.ramp.is_some() || e.actuator.is_some() {
+            if fidelity == Fidelity::Full && (e.ramp.is_some() || e.actuator.is_some()) {
                 return Err(SimError::Unsupported(
-                    "method rkn86 needs a drive periodic from t = 0: it cannot run effects.ramp or effects.actuator (use dop853)",
+                    "method rkn86 on the full model needs a drive periodic from t = 0: it cannot run effects.ramp or effects.actuator (use dop853)",
                 ));
             }
             if e.coulomb.is_some() {
                 return Err(SimError::Unsupported(
                     "method rkn86 cannot run effects.coulomb: stick–slip needs event location (use dop853)",
+                ));
+            }
+        }
+        Method::Rkn1210 { rtol, atol } => {
+            tolerances(rtol, atol)?;
+            if scene.effects.coulomb.is_some() {
+                return Err(SimError::Unsupported(
+                    "method rkn1210 cannot run effects.coulomb: stick–slip needs event location (use dop853)",
                 ));
             }
         }
@@ -347,6 +412,7 @@ fn run_format<R: Real, Rec: Recorder>(
         } else {
             16.0 * math::TAU / p.omega
         },
+        beta: options.controller.beta(),
     };
     let a1 = p.amplitude / p.ell;
     let mut report = if shaped(scene) {
@@ -384,16 +450,31 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
 ) -> Result<Report, SimError> {
     let full =
         || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
+    let averaged = || {
+        let r_eff = averaged_r(scene, p);
+        AveragedEom::<R, D, _>::new(p.omega0 * p.omega0, r_eff, scene.drive.angle, sig, NoExtra)
+    };
     let out = match (scene.effects.coulomb, ctx.method) {
         (Some(mu), _) => friction::run(full(), R::from_f64(p.c), mu, ctx, rec)?,
-        (None, Method::Rkn86 { rtol, atol }) => {
-            if decision.fidelity != Fidelity::Full {
-                return Err(SimError::Unsupported(
-                    "method rkn86 integrates the full equation only: set run.fidelity = \"full\", or use dop853",
-                ));
+        (None, Method::Rkn86 { rtol, atol }) => match decision.fidelity {
+            Fidelity::Full => periodic::run(full(), p.c, (rtol, atol), ctx, rec)?,
+            Fidelity::Averaged => {
+                let eom = averaged();
+                adaptive::run(Slow(&eom), &RKN86, p.c, (rtol, atol), ctx, rec)?
             }
-            periodic::run(full(), p.c, (rtol, atol), ctx, rec)?
-        }
+            Fidelity::Linearised => return Err(SimError::Unsupported(NOT_LINEARISED)),
+        },
+        (None, Method::Rkn1210 { rtol, atol }) => match decision.fidelity {
+            Fidelity::Full => {
+                let eom = full();
+                adaptive::run(Fast(&eom), &RKN1210, p.c, (rtol, atol), ctx, rec)?
+            }
+            Fidelity::Averaged => {
+                let eom = averaged();
+                adaptive::run(Slow(&eom), &RKN1210, p.c, (rtol, atol), ctx, rec)?
+            }
+            Fidelity::Linearised => return Err(SimError::Unsupported(NOT_LINEARISED)),
+        },
         (None, _) => with_equation(scene, p, decision, sig, Integrate { ctx, rec })?,
     };
     let RunOut {
@@ -539,6 +620,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
         Method::Dop853 { rtol, atol } => {
             let mut solver = Dop853::new(rtol, atol);
             solver.h_max = ctx.h_max;
+            solver.beta = ctx.beta;
             solver.max_steps = u64::MAX;
             loop {
                 let offset = turns.offset();
@@ -577,9 +659,9 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             let n_h = fixed_steps(ctx, steps_per_period);
             (t, y) = in_stretches(&driver, &sys, n_h, y, &mut turns, &mut sampler, &mut work);
         }
-        Method::Rkn86 { .. } => {
+        Method::Rkn86 { .. } | Method::Rkn1210 { .. } => {
             return Err(SimError::Unsupported(
-                "method rkn86 runs the full equation through its own loop",
+                "the RKN methods run through their own loops",
             ))
         }
         Method::Rk4 { steps_per_period } => {

@@ -28,6 +28,8 @@ pub trait DriveSignal<R: Real>: Copy {
     fn strength(&self, t: f64) -> R;
     /// The time at which the drive phase reaches 2πk: the k-th stroboscopic instant.
     fn strobe_time(&self, k: u64) -> f64;
+    /// Whether [`DriveSignal::strength`] is the same at every t (no ramp, no lag).
+    fn constant_strength(&self) -> bool;
 }
 
 /// A steady sinusoid A cos(Wt): no ramp, no lag, no second harmonic.
@@ -55,6 +57,9 @@ impl<R: Real> DriveSignal<R> for Steady<R> {
     #[inline]
     fn strength(&self, _t: f64) -> R {
         R::ONE
+    }
+    fn constant_strength(&self) -> bool {
+        true
     }
     fn strobe_time(&self, k: u64) -> f64 {
         k as f64 * math::TAU / self.omega
@@ -208,6 +213,9 @@ impl<R: Real> DriveSignal<R> for Shaped<R> {
     fn strength(&self, t: f64) -> R {
         let r = self.schedule.state(t).omega / self.schedule.omega;
         R::from_f64(r * r)
+    }
+    fn constant_strength(&self) -> bool {
+        self.schedule.ramp.is_none() && self.schedule.lag.is_none()
     }
     fn strobe_time(&self, k: u64) -> f64 {
         self.schedule.time_of_phase(k as f64 * math::TAU)

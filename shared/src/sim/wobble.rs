@@ -172,6 +172,9 @@ mod tests {
         fn strength(&self, _t: f64) -> f64 {
             1.0
         }
+        fn constant_strength(&self) -> bool {
+            true
+        }
         fn strobe_time(&self, k: u64) -> f64 {
             k as f64 * math::TAU / self.omega
         }

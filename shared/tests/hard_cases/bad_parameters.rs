@@ -36,7 +36,7 @@ use kapitza_core::sim::classify::Outcome;
 use kapitza_core::sim::scene::{
     DriveFrequency, FidelityChoice, RunLength, Sensor, Viscous, MAX_PERIODS,
 };
-use kapitza_core::sim::{simulate, Format, Method, Options, Recorder, Scene, SimError};
+use kapitza_core::sim::{simulate, Controller, Format, Method, Options, Recorder, Scene, SimError};
 use kapitza_core::stability::floquet::{self, Floquet};
 use kapitza_core::stability::{averaging, harmonic_balance, mathieu, End, Window};
 use proptest::prelude::*;
@@ -753,6 +753,10 @@ fn method() -> impl Strategy<Value = Method> {
         Just(Method::DEFAULT),
         (or_good(1e-10..1e-4), or_good(1e-10..1e-4))
             .prop_map(|(rtol, atol)| Method::Dop853 { rtol, atol }),
+        (or_good(1e-10..1e-4), or_good(1e-10..1e-4))
+            .prop_map(|(rtol, atol)| Method::Rkn86 { rtol, atol }),
+        (or_good(1e-10..1e-4), or_good(1e-10..1e-4))
+            .prop_map(|(rtol, atol)| Method::Rkn1210 { rtol, atol }),
         // Bad step counts, 1e300 included, must be refused (more than 1e6 per period).
         prop_oneof![extreme(), Just(1.0), Just(3.0), 10.0..200.0]
             .prop_map(|steps_per_period| Method::Rk4 { steps_per_period }),
@@ -803,6 +807,7 @@ proptest! {
         f32 in any::<bool>(),
         classify in any::<bool>(),
         auto in any::<bool>(),
+        pi in any::<bool>(),
         // A tiny out_dt (1e-300) must be refused (more than 1e9 samples), not sample for ever.
         out_dt in prop_oneof![extreme(), 1e-3..0.1],
     ) {
@@ -812,6 +817,7 @@ proptest! {
         }
         let opts = Options {
             method,
+            controller: if pi { Controller::Pi } else { Controller::Standard },
             format: if f32 { Format::F32 } else { Format::F64 },
             out_dt,
             seed: 7,

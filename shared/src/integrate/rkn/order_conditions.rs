@@ -1,4 +1,5 @@
-//! The RKN 8(6) table checked against every Nyström order condition, generated from the trees.
+//! The RKN 8(6) and 12(10) tables checked against every Nyström order condition, generated from
+//! the trees.
 //!
 //! For y'' = f(y) (time enters as a component with t'' = 0) the Taylor terms of y are the
 //! elementary differentials of *Nyström trees*: a fat vertex f^(m) whose m arguments are each
@@ -19,7 +20,7 @@
 //! ```
 //! (HNW I §II.14: the same conditions, indexed by special Nyström trees.)
 
-use super::tableau::{A, B, B6, BBAR, BBAR6, C, STAGES};
+use super::{Pair, RKN1210, RKN86};
 
 /// An argument of a fat vertex.
 #[derive(Clone, Copy)]
@@ -63,21 +64,21 @@ fn nystrom_trees(max_order: usize) -> Vec<NTree> {
 }
 
 /// Per tree: Φ_i over the stages, and κ of the exact solution's Φ(τ) = κ τ^(|u|−2).
-fn weights(trees: &[NTree]) -> Vec<([f64; STAGES], f64)> {
-    let mut out: Vec<([f64; STAGES], f64)> = Vec::new();
+fn weights<const S: usize>(pair: &Pair<S>, trees: &[NTree]) -> Vec<([f64; S], f64)> {
+    let mut out: Vec<([f64; S], f64)> = Vec::new();
     for t in trees {
-        let (mut phi, mut kappa) = ([1.0; STAGES], 1.0);
+        let (mut phi, mut kappa) = ([1.0; S], 1.0);
         for arg in &t.args {
             match *arg {
                 Arg::Rate => {
-                    for (p, c) in phi.iter_mut().zip(C) {
+                    for (p, c) in phi.iter_mut().zip(pair.c) {
                         *p *= c;
                     }
                 }
                 Arg::Tree(j) => {
                     let (inner, k) = &out[j];
                     for (i, p) in phi.iter_mut().enumerate() {
-                        *p *= (0..STAGES).map(|m| A[i][m] * inner[m]).sum::<f64>();
+                        *p *= (0..S).map(|m| pair.a[i][m] * inner[m]).sum::<f64>();
                     }
                     // ∫_0^τ (τ − s) k s^n ds = k τ^(n+2) / ((n + 1)(n + 2)), n = |v| − 2.
                     let n = trees[j].order as f64 - 2.0;
@@ -92,13 +93,13 @@ fn weights(trees: &[NTree]) -> Vec<([f64; STAGES], f64)> {
 
 /// The largest residual of the position conditions up to order `p` and of the velocity
 /// conditions up to order `p + 1`, for weights `bbar`, `b`.
-fn worst_residual(bbar: &[f64; STAGES], b: &[f64; STAGES], p: usize) -> f64 {
+fn worst_residual<const S: usize>(pair: &Pair<S>, bbar: &[f64; S], b: &[f64; S], p: usize) -> f64 {
     let trees = nystrom_trees(p + 1);
-    let w = weights(&trees);
+    let w = weights(pair, &trees);
     let mut worst: f64 = 0.0;
     for (t, (phi, kappa)) in trees.iter().zip(&w) {
         let q = t.order as f64;
-        let dot = |x: &[f64; STAGES]| x.iter().zip(phi).map(|(a, b)| a * b).sum::<f64>();
+        let dot = |x: &[f64; S]| x.iter().zip(phi).map(|(a, b)| a * b).sum::<f64>();
         if t.order <= p {
             worst = worst.max((dot(bbar) - kappa / ((q - 1.0) * q)).abs());
         }
@@ -120,23 +121,48 @@ fn tree_counts() {
 #[test]
 fn order_8_solution_meets_every_condition() {
     // Exact rationals in f64: residuals at rounding, 1e-14 (the largest coefficients are ~10).
-    let r = worst_residual(&BBAR, &B, 8);
+    let p = &RKN86;
+    let r = worst_residual(p, &p.bbar, &p.b, 8);
     assert!(r < 1e-14, "order 8: worst residual {r:e}");
     // And not order 9: the check can tell the difference.
-    assert!(worst_residual(&BBAR, &B, 9) > 1e-8);
+    assert!(worst_residual(p, &p.bbar, &p.b, 9) > 1e-8);
 }
 
 #[test]
 fn order_6_solution_meets_every_condition() {
-    let r = worst_residual(&BBAR6, &B6, 6);
+    let p = &RKN86;
+    let r = worst_residual(p, &p.bbar_low, &p.b_low, 6);
     assert!(r < 1e-14, "order 6: worst residual {r:e}");
-    assert!(worst_residual(&BBAR6, &B6, 7) > 1e-8);
+    assert!(worst_residual(p, &p.bbar_low, &p.b_low, 7) > 1e-8);
 }
 
 #[test]
 fn a_mistyped_coefficient_is_caught() {
     // One weight off in its fifth digit breaks an order condition far above rounding.
-    let mut b = B;
+    let mut b = RKN86.b;
     b[4] *= 1.0 + 1e-5;
-    assert!(worst_residual(&BBAR, &b, 8) > 1e-7);
+    assert!(worst_residual(&RKN86, &RKN86.bbar, &b, 8) > 1e-7);
+    let mut a = RKN1210.a;
+    // In the 12(10) table, one of the largest coefficients off in its tenth digit.
+    a[14][5] *= 1.0 + 1e-9;
+    let typo = Pair { a, ..RKN1210 };
+    assert!(worst_residual(&typo, &typo.bbar, &typo.b, 12) > 1e-11);
+}
+
+#[test]
+fn order_12_solution_meets_every_condition() {
+    // The nearest f64 to each published rational: residuals at rounding (coefficients reach
+    // ~20 in magnitude, with cancellation), bounded by 1e-13; order 13 fails by 1.8e-8.
+    let p = &RKN1210;
+    let r = worst_residual(p, &p.bbar, &p.b, 12);
+    assert!(r < 1e-13, "order 12: worst residual {r:e}");
+    assert!(worst_residual(p, &p.bbar, &p.b, 13) > 1e-9);
+}
+
+#[test]
+fn order_10_solution_meets_every_condition() {
+    let p = &RKN1210;
+    let r = worst_residual(p, &p.bbar_low, &p.b_low, 10);
+    assert!(r < 1e-13, "order 10: worst residual {r:e}");
+    assert!(worst_residual(p, &p.bbar_low, &p.b_low, 11) > 1e-9);
 }
