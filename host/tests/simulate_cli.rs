@@ -223,3 +223,63 @@ fn unwritable_out_is_refused_before_the_run_and_set_is_flagged() {
     let done = child.wait_with_output().unwrap();
     assert_eq!(done.status.code(), Some(0), "{}", text(&done.stderr));
 }
+
+/// Width and height from a PNG's IHDR chunk.
+fn png_size(path: &Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap();
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn window_in_periods_or_seconds_writes_both_plots() {
+    let scene = data("sim_full_sensor.toml");
+    let scene = scene.to_str().unwrap();
+    for window in ["8", "1.5s"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = kapitza(&[
+            "simulate",
+            scene,
+            "--out",
+            dir.path().to_str().unwrap(),
+            "--window",
+            window,
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        for f in ["angle.png", "phase.png"] {
+            let p = dir.path().join(f);
+            assert!(is_png(&p), "{window}: {f}");
+            // Slide-sized: 1600 × 1000 pixels.
+            assert_eq!(png_size(&p), (1600, 1000), "{window}: {f}");
+        }
+    }
+    // Not a window: a usage error. A window too long to hold in memory: refused before the run.
+    assert_eq!(
+        kapitza(&["simulate", scene, "--window", "0"]).status.code(),
+        Some(2)
+    );
+    assert_eq!(
+        kapitza(&["simulate", scene, "--window", "2x"])
+            .status
+            .code(),
+        Some(2)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = kapitza(&[
+        "simulate",
+        scene,
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--window",
+        "500",
+        "--samples-per-period",
+        "10000",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("--window"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(out.stdout.is_empty());
+}

@@ -8,12 +8,13 @@ use std::time::Instant;
 
 use crate::cmd::predict::EquilibriumOut;
 use crate::outcome::{self, Judged, OutcomeOut};
-use crate::record::{self, Collect};
+use crate::record::{Collect, Plan};
 use crate::scene_file::{self, SceneFile};
 use crate::{csv_out, plot};
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::model::equilibria;
+use kapitza_core::sim::fidelity;
 use kapitza_core::sim::scene::{Fidelity, FidelityChoice};
 use kapitza_core::sim::{simulate, Format, Method, Options, Report};
 
@@ -39,10 +40,48 @@ pub struct Args {
     /// Exit with status 1 unless the scene's [expect] table is met (a scene without one fails).
     #[arg(long)]
     pub check: bool,
-    /// Time-series samples per drive period for series.csv and the plots (at most 200 000
-    /// samples in all: long runs are sampled more sparsely).
+    /// Time-series samples per drive period for series.csv (at most 200 000 samples in all:
+    /// long runs keep every n-th). The plots sample at least 64 a period.
     #[arg(long, value_name = "N", default_value_t = 20, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub samples_per_period: u32,
+    /// The end of the run the plots draw at full resolution: drive periods (`--window 20`) or
+    /// seconds (`--window 1.5s`).
+    #[arg(long, value_name = "PERIODS|SECONDSs", default_value = "20")]
+    pub window: WindowLength,
+}
+
+/// The length of the end window: drive periods, or seconds with an `s`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WindowLength {
+    Periods(u64),
+    Seconds(f64),
+}
+
+impl WindowLength {
+    /// Whole drive periods (at least one) of `period` seconds.
+    pub fn periods(self, period: f64) -> u64 {
+        match self {
+            Self::Periods(n) => n,
+            Self::Seconds(s) => (s / period - 1e-9).ceil().max(1.0) as u64,
+        }
+    }
+}
+
+impl std::str::FromStr for WindowLength {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}` is not a window: give drive periods (20) or seconds (1.5s)");
+        match s.trim().strip_suffix('s') {
+            Some(secs) => match secs.trim().parse::<f64>() {
+                Ok(x) if x.is_finite() && x > 0.0 => Ok(Self::Seconds(x)),
+                _ => Err(bad()),
+            },
+            None => match s.trim().parse::<u64>() {
+                Ok(n) if n > 0 => Ok(Self::Periods(n)),
+                _ => Err(bad()),
+            },
+        }
+    }
 }
 
 /// The `--json` output, also written to `summary.json`.
@@ -143,21 +182,32 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         crate::chart::draw::prepare_dir(dir)?;
     }
     let p = file.scene.physical().map_err(|e| anyhow!("{name}: {e}"))?;
-    let duration = file.scene.duration(p.omega);
-    let out_dt = if args.out.is_some() {
-        record::output_interval(math::TAU / p.omega, args.samples_per_period, duration)
-    } else {
-        0.0
+    let period = math::TAU / p.omega;
+    let plan = match &args.out {
+        Some(_) => {
+            let averaged =
+                fidelity::decide(&file.scene, &p).is_ok_and(|d| d.fidelity == Fidelity::Averaged);
+            let plan = Plan::new(
+                period,
+                file.scene.duration(p.omega) / period,
+                args.samples_per_period,
+                args.window.periods(period),
+                !averaged,
+            )
+            .map_err(|e| anyhow!("{e}"))?;
+            Some(plan)
+        }
+        None => None,
     };
     let options = Options {
         method: file.method,
         controller: file.controller,
         format: file.format,
-        out_dt,
+        out_dt: plan.map_or(0.0, |p| p.dt),
         seed: file.seed,
         ..Options::default()
     };
-    let mut rec = Collect::new(args.out.is_some());
+    let mut rec = Collect::new(plan);
     let start = Instant::now();
     let result = simulate(&file.scene, &options, &mut rec);
     let wall = start.elapsed().as_secs_f64();
@@ -380,7 +430,8 @@ fn write_out(dir: &Path, file: &SceneFile, s: &Summary, rec: &Collect) -> Result
         written.push(p.clone());
         p
     };
-    csv_out::series(&path("series.csv"), &rec.series)?;
+    let kept = rec.kept.as_ref().context("the run kept no samples")?;
+    csv_out::series(&path("series.csv"), &kept.series)?;
     csv_out::strobes(&path("strobes.csv"), &rec.strobes)?;
     if file.scene.effects.sensor.is_some() {
         csv_out::sensed(&path("sensed.csv"), &rec.sensed)?;
@@ -389,10 +440,6 @@ fn write_out(dir: &Path, file: &SceneFile, s: &Summary, rec: &Collect) -> Result
     let mut text = serde_json::to_string_pretty(s)?;
     text.push('\n');
     std::fs::write(&json, text).with_context(|| format!("cannot write {}", json.display()))?;
-    let centre = s
-        .outcome
-        .angle_deg()
-        .unwrap_or_else(|| outcome::deg(rec.series.last().map_or(0.0, |x| x[1])));
     let title = if s.sets.is_empty() {
         s.title.clone()
     } else {
@@ -404,15 +451,16 @@ fn write_out(dir: &Path, file: &SceneFile, s: &Summary, rec: &Collect) -> Result
             "R = {:.3}, θd = {}°, ω = {:.1} rad/s, {} model, {}  —  outcome: {}",
             s.r, s.drive_angle_deg, s.omega, s.fidelity.used, s.method, s.outcome
         ),
-        series: &rec.series,
-        strobes: rec.strobes.iter().map(|r| (r.theta, r.rate)).collect(),
+        first: kept.first.buckets(),
+        first_is_whole: kept.first.is_complete(),
+        whole: kept.whole.buckets(),
+        window: kept.window.samples().copied().collect(),
+        strobes: rec.strobes.iter().map(|r| (r.t, r.theta, r.rate)).collect(),
         equilibria: equilibria(s.r_effective, file.scene.drive.angle)
             .context("predicted equilibria")?
             .as_slice()
             .map(|e| (outcome::deg(e.angle), e.stability))
             .collect(),
-        window_lo: plot::window_lo(centre),
-        t_end: s.duration_s,
         averaged: s.fidelity.used == "averaged",
     };
     plot::angle_png(&path("angle.png"), &input)?;

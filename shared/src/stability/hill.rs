@@ -59,10 +59,10 @@ use crate::math;
 /// Harmonics on each side of r = 0 for the pair (a, q): enough that the eigenvalues below a
 /// have converged to rounding.
 pub fn harmonics(a: f64, q: f64) -> usize {
-    // (2N)² ≥ 4(|a| + 2|q|) + 1600: every coefficient past the window's harmonics shrinks by at
-    // least a factor 4 per step from there, 20 steps beyond it: 4^−20 ≈ 1e-12, squared in λ.
+    // Past r₀ = √(|a| + 2|q|) the coefficients fall by |q|/((2r)² − |a|) ≤ 1/8 per harmonic;
+    // 10 beyond it: 8^−10 ≈ 1e-9 in the coefficients, squared (≈ 1e-18) in the eigenvalue.
     let s = math::sqrt(a.abs() + 2.0 * q.abs());
-    (s as usize) + 20
+    (s as usize) + 10
 }
 
 /// The number of eigenvalues of T(ν, q) (N harmonics each side) below x: a Sturm count.

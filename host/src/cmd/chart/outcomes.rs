@@ -2,12 +2,12 @@
 //! `kapitza chart merge`, which joins the shards of such a map.
 
 use anyhow::{anyhow, bail, Context, Result};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -15,8 +15,8 @@ use super::options::{write_csv, Output, Size};
 use crate::chart::draw::{self, pe, tint, Figure, SERIES};
 use crate::chart::map::samples;
 use crate::outcome::OutcomeOut;
+use crate::record::{self, Share, PROGRESS_STEPS};
 use crate::scene_file;
-use kapitza_core::sim::sampling::Discard;
 use kapitza_core::sim::{simulate, Options};
 
 /// A map of outcomes: every cell a simulation of SCENE with two keys swept (`--set` syntax),
@@ -139,19 +139,13 @@ pub struct Map {
     pub cells: Vec<Cell>,
 }
 
+/// A bar over `n` cells that moves within each cell as its run reports progress.
 fn progress(n: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(
-        Some(n),
-        if std::io::stderr().is_terminal() {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
-        },
+    let bar = record::bar(
+        n * PROGRESS_STEPS,
+        "{spinner} {bar:40} {percent:>3}% of {msg} cells, {elapsed} elapsed, ETA {eta}",
     );
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} cells, {elapsed} elapsed, ETA {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    bar.set_message(n.to_string());
     bar
 }
 
@@ -189,7 +183,8 @@ pub fn compute(args: &Args) -> Result<Map> {
                 ..Options::default()
             };
             let t = Instant::now();
-            let report = simulate(&file.scene, &options, &mut Discard).map_err(|e| {
+            let mut share = Share::new(&bar);
+            let report = simulate(&file.scene, &options, &mut share).map_err(|e| {
                 anyhow!(
                     "{name} at {} = {}, {} = {}: {e}",
                     args.x.key,
@@ -199,7 +194,7 @@ pub fn compute(args: &Args) -> Result<Map> {
                 )
             })?;
             let wall_s = t.elapsed().as_secs_f64();
-            bar.inc(1);
+            share.finish();
             Ok(Cell {
                 i,
                 j,

@@ -29,6 +29,8 @@ pub const NOT_FLUTTER: &str = "the window ends at tr M = +2, not at a period-2 (
 /// Reason: the exponent does not pass 2/n inside the window.
 pub const TRACE_NOT_REACHED: &str = "tr M does not pass 2 cos(2π/n) inside the window";
 
+/// Bisections that sharpen each gap bound (to within 1/8 of the distance).
+const GAP_REFINE: u32 = 3;
 /// How many certified steps ahead the extrapolation may look.
 const LOOK_AHEAD: f64 = 8.0;
 /// Smallest step in q of the walk: where a characteristic value stays within 2e-6 of a (a
@@ -104,19 +106,36 @@ impl Windows {
     }
 
     /// A lower bound on the distance from a to the nearest characteristic value at q, halving
-    /// from four times the last one (at most 8) down to a quarter of the smallest step.
+    /// from four times the last one (at most 8) down to a quarter of the smallest step, then
+    /// bisected to within 1/2^[`GAP_REFINE`] of the true distance, so that the extrapolation
+    /// in [`Windows::next`] sees how fast the value approaches.
     fn gap(&mut self, q: f64) -> f64 {
         let n = harmonics(self.a + 8.0, q);
         let c = self.count;
+        let a = self.a;
         let start = (4.0 * self.last_gap).clamp(MIN_STEP_Q, 8.0);
         let mut side = |sign: f64| {
+            // Below a: C(a − d) = C(a) means nothing in [a − d, a); above: C(a + d) = C(a).
+            let mut clear = |d: f64| {
+                self.counts += 1;
+                let x = a + sign * d;
+                count_below(0.0, q, x, n) + count_below(1.0, q, x, n) == c
+            };
             let mut d = start;
             while d > 0.25 * MIN_STEP_Q {
-                self.counts += 1;
-                let x = self.a + sign * d;
-                let cx = count_below(0.0, q, x, n) + count_below(1.0, q, x, n);
-                // Below a: C(a − d) = C(a) means nothing in [a − d, a); above: C(a + d) = C(a).
-                if cx == c {
+                if clear(d) {
+                    // A value lies within 2d (unless d is the start): close in on it.
+                    if d < start {
+                        let mut hi = 2.0 * d;
+                        for _ in 0..GAP_REFINE {
+                            let mid = 0.5 * (d + hi);
+                            if clear(mid) {
+                                d = mid;
+                            } else {
+                                hi = mid;
+                            }
+                        }
+                    }
                     return d;
                 }
                 d *= 0.5;
