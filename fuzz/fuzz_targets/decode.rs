@@ -21,14 +21,14 @@ fuzz_target!(|data: &[u8]| {
             copy[..stuffed.len()].copy_from_slice(stuffed);
             let len = stuffed.len();
             if let (seq, Ok(req)) = receive_request(stuffed) {
-                let mut rig = kapitza_core::link::serve::RigServer::new(
+                let mut rig = kapitza_core::station::serve::RigServer::new(
                     kapitza_core::rig::config::RigConfig::REFERENCE,
                     kapitza_core::persist::ConfigOrigin::Stored,
                     kapitza_core::rig::fixed::Angle::ZERO,
-                    kapitza_core::link::serve::Clock::single(0, 0),
+                    kapitza_core::station::serve::Clock::single(0, 0),
                     [0, 1, 0],
                 );
-                let _ = rig.respond(req, kapitza_core::link::serve::Clock::single(1000, 1), false);
+                let _ = rig.respond(req, kapitza_core::station::serve::Clock::single(1000, 1), false);
                 // Re-encode: the same payload as the one accepted.
                 let mut out = [0u8; MAX_REQUEST_FRAME];
                 let n = encode(Header::new(seq), &req, &mut out).expect("fits");

@@ -1,6 +1,6 @@
 //! The lecture demo as a script over the monitor's [`Feed`]: the commands a lecturer would
 //! type, each step waiting until the rod has settled, its measurement set against the averaged
-//! theory's prediction (SPEC §3).
+//! theory's prediction (physics §3).
 //!
 //! ```text
 //! 0  drive off                 hanging at rest for REST_S
@@ -14,7 +14,7 @@
 //! A step is measured at the first frame taken after its command (the telemetry's command
 //! counter above the count before it: a snapshot from before the command never counts) that is
 //! steady, settled and carries φ0. R in situ comes with it where the rig can tell: at θd = 180°
-//! the equilibrium formula is singular and R comes from ωp alone (SPEC §7), so a rod that
+//! the equilibrium formula is singular and R comes from ωp alone (physics §7), so a rod that
 //! reaches the top without a slow swing to time (lowered gently from R = 2.2 to 1.75, say)
 //! reports no ωp and no R.
 

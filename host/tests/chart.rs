@@ -24,7 +24,7 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-/// Closed form of the saddle-node curve (SPEC §3).
+/// Closed form of the saddle-node curve (physics §3).
 fn r_sn(deg: f64) -> f64 {
     let (s, c) = deg.to_radians().sin_cos();
     (s.abs().powf(2.0 / 3.0) + c.abs().powf(2.0 / 3.0)).powf(1.5)
@@ -64,7 +64,7 @@ fn regions_band_ends_lie_on_the_saddle_node_curve() {
 
 #[test]
 fn equilibria_chart_matches_the_closed_forms() {
-    // SPEC §3: θd = 90°, R > 1: stable φ0 = ±arccos(1/R), +55.15° within 90° of the drive;
+    // physics §3: θd = 90°, R > 1: stable φ0 = ±arccos(1/R), +55.15° within 90° of the drive;
     // θd = 180°, R > 1: inverted stable; θd = 0°: hanging stable.
     let v = run_json(&["equilibria", "--r", "1.75", "--samples", "9"]);
     let at = |th: f64| -> Vec<(f64, String, bool)> {
@@ -89,7 +89,7 @@ fn equilibria_chart_matches_the_closed_forms() {
     assert!(stable90.iter().any(|e| (e.0 + want).abs() < 1e-9 && !e.2));
     assert!(at(180.0).iter().any(|e| e.0 == 180.0 && e.1 == "stable"));
     assert!(at(0.0).iter().any(|e| e.0 == 0.0 && e.1 == "stable"));
-    // The pendulum form converts to R (SPEC §4 table: the demo rod gives R = 1.7433).
+    // The pendulum form converts to R (physics §4.5: the demo rod gives R = 1.7433).
     let v = run_json(&[
         "equilibria",
         "--rod",
@@ -179,7 +179,7 @@ fn stability_chart_agrees_with_boundary_and_the_published_values() {
         }
     }
     // Order-8 threshold at k = −0.3: Floquet 0.877173 (docs/stability.md), harmonic balance
-    // 0.8773 (SPEC §4 table).
+    // 0.8773 (physics §4.5).
     let k = *ks.iter().find(|x| (**x + 0.3).abs() < 1e-12).unwrap();
     for (criterion, want, tol) in [
         ("floquet", 0.877173, 5e-7),
@@ -216,7 +216,7 @@ fn stability_chart_hanging_windows_are_numbered() {
 
 #[test]
 fn stability_chart_pendulum_form_matches_boundary() {
-    // SPEC §4 (Landau): point mass l = 1 m, ω = 9 rad/s: Floquet's lower end A = 0.5173 m
+    // physics §4 (Landau): point mass l = 1 m, ω = 9 rad/s: Floquet's lower end A = 0.5173 m
     // (docs/stability.md); the chart's record at ω = 9 equals `boundary --point 1 --omega 9`.
     let v = run_json(&[
         "stability",

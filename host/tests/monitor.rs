@@ -120,7 +120,7 @@ fn dashboard_running_snapshot() {
     let text = screen(&s, 100, 32);
     snapshot("monitor_running", &text);
     // What the snapshot must show, whatever the layout: predicted φ0 = arccos(1/1.75) =
-    // 55.15° (SPEC §3), the settled flag, and the stop key.
+    // 55.15° (physics §3), the settled flag, and the stop key.
     assert!(text.contains("55.15"), "{text}");
     assert!(text.contains("settled"), "{text}");
     assert!(text.contains("STOP the drive"), "{text}");
@@ -273,7 +273,7 @@ fn demo_settles_where_the_model_says() {
     let v: Value = serde_json::from_slice(&out).unwrap();
     let steps = v["steps"].as_array().unwrap();
     assert_eq!(steps.len(), 4, "{v}");
-    // Independent references (SPEC §3): R = 1.75 at θd = 90° settles at arccos(1/1.75) =
+    // Independent references (physics §3): R = 1.75 at θd = 90° settles at arccos(1/1.75) =
     // 55.15°; at θd = 180° with R > 1 the rod stands inverted, φ0 = 180°. The rest step hangs
     // at 0°.
     let want = [0.0, (1.0f64 / 1.75).acos().to_degrees(), 180.0, 180.0];
@@ -293,7 +293,7 @@ fn demo_settles_where_the_model_says() {
     }
     for s in &steps[1..3] {
         // R in situ within 2 % of R requested (the demo's acceptance bound), and ωp within 2 %
-        // of ω0 √(cos φ0 + R cos 2(φ0 − θd)) (SPEC §3).
+        // of ω0 √(cos φ0 + R cos 2(φ0 − θd)) (physics §3).
         let r = s["r"].as_f64().unwrap();
         let est = s["measured"]["r"].as_f64().expect("R in situ");
         assert!((est / r - 1.0).abs() < 0.02, "R {est} against {r}: {s}");
@@ -305,7 +305,7 @@ fn demo_settles_where_the_model_says() {
         );
     }
     // Lowered gently from R = 2.2 to 1.75 at θd = 180°, the rod stays at the top without a slow
-    // swing; there R comes only from ωp (the equilibrium formula is 0/0, SPEC §7), so the rig
+    // swing; there R comes only from ωp (the equilibrium formula is 0/0, physics §7), so the rig
     // has neither to report.
     assert!(steps[3]["measured"]["omega_p"].is_null(), "{}", steps[3]);
     assert!(steps[3]["measured"]["r"].is_null(), "{}", steps[3]);

@@ -157,7 +157,7 @@ fn settles_where_the_model_says() {
     );
     let r = v["r_estimate"].as_f64().unwrap();
     assert!((r / 1.75 - 1.0).abs() < 0.02, "R in situ {r}");
-    // The averaged theory's closed form, arccos(1/R) = 55.15° (SPEC §3), as `predicted`.
+    // The averaged theory's closed form, arccos(1/R) = 55.15° (physics §3), as `predicted`.
     let p = v["predicted"]["phi0_deg"].as_f64().unwrap();
     assert!((p - 55.150).abs() < 0.01, "{p}");
     eprintln!("settled at {phi:.3}° (full model {reference:.3}°), R in situ {r:.4}");

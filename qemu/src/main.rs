@@ -1,5 +1,5 @@
-//! On-target test harness: runs every scenario of `kapitza_core::rig::selftest` and
-//! `kapitza_core::station::selftest` (the firmware's rig loop, bytes in and out) on the emulated
+//! On-target test harness: runs every scenario of `kapitza_core::selftest::rig` and
+//! `kapitza_core::selftest::station` (the firmware's rig loop, bytes in and out) on the emulated
 //! Cortex-M4F and compares its digest with the expected one — the same digests the host tests
 //! check, so a pass here means host and target compute the same bits. Prints one line per
 //! scenario and `N passed, N failed`, and exits with a failure status if any failed.
@@ -9,8 +9,8 @@
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use kapitza_core::rig::selftest::CASES;
-use kapitza_core::station::selftest::CASES as LOOP_CASES;
+use kapitza_core::selftest::rig::CASES;
+use kapitza_core::selftest::station::CASES as LOOP_CASES;
 
 #[entry]
 fn main() -> ! {

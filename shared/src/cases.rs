@@ -1,6 +1,6 @@
-//! Canonical cases with known answers: the reference table of SPEC §4 as named values, shared by
+//! Canonical cases with known answers: the reference table of physics §4 as named values, shared by
 //! tests, benchmarks and scenes. Each printed value carries the tolerance its printed digits imply
-//! (half a unit in the last place), so a test can say "agrees with the SPEC as printed".
+//! (half a unit in the last place), so a test can say "agrees with the reference as printed (physics §4.5)".
 
 /// A number as printed in a reference, with half a unit in its last printed place.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,7 +29,7 @@ const fn printed(value: f64, decimals: i32) -> Printed {
     }
 }
 
-/// Stability boundaries in m = A/ℓ at one signed k (point-mass form), as printed in SPEC §4.
+/// Stability boundaries in m = A/ℓ at one signed k (point-mass form), as printed in physics §4.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryCase {
     pub k: f64,

@@ -119,7 +119,7 @@ pub fn to_deg(rad: f64) -> f64 {
 /// sin and cos of an angle given in degrees, exact at multiples of 90°.
 ///
 /// `sin(to_rad(180.0))` is 1.2e-16, not 0; at θd = 0°, 90°, 180° that residue would break exact
-/// symmetries (and the special cases of SPEC §3), so quadrant multiples are reduced first.
+/// symmetries (and the special cases of physics §3), so quadrant multiples are reduced first.
 pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
     let d = wrap_deg(deg);
     let quarter = libm::round(d / 90.0);

@@ -1,7 +1,7 @@
 //! Small real polynomials: arithmetic, exact determinants of polynomial matrices, and robust
 //! real-root isolation.
 //!
-//! The stability boundaries of harmonic balance (SPEC §4, level 3) and of the Mathieu series
+//! The stability boundaries of harmonic balance (physics §4, level 3) and of the Mathieu series
 //! (level 2) are real roots of polynomials of degree ≤ 7. They are found here without
 //! allocation and without a starting guess:
 //!

@@ -1,5 +1,5 @@
 //! Properties of the equilibrium finder over the whole (R, θd) plane, and its behaviour at the
-//! special and merging points of SPEC §3.
+//! special and merging points of physics §3.
 
 use kapitza_core::math;
 use kapitza_core::model::equilibria::{
@@ -83,7 +83,7 @@ proptest! {
 
     #[test]
     fn strong_drive_always_reaches_a_stable_tilt(r in 2.0f64..20.0, deg in -180.0f64..180.0) {
-        // SPEC §4 table: for R > 2 a stable φ0 within 90° of θd exists at every θd.
+        // physics §4.5: for R > 2 a stable φ0 within 90° of θd exists at every θd.
         prop_assume!(r > 2.0 + 1e-9);
         let eqs = equilibria(r, drive(deg)).unwrap();
         prop_assert!(eqs.stable().any(|e| e.within_90_of_drive));

@@ -241,7 +241,7 @@ fn backward_integration_returns_to_the_start() {
     assert!(dist(sol.y, [math::cos(5.0), math::sin(5.0)]) < 1e-9);
 }
 
-/// The fast-drive pendulum of SPEC §3 with ω0 = 1, ω = 100, A/ℓ = 0.02 (R = 2), θd = π:
+/// The fast-drive pendulum of physics §3 with ω0 = 1, ω = 100, A/ℓ = 0.02 (R = 2), θd = π:
 /// θ'' = −sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt. Fast and stiff-ish: 100 drive periods per slow one.
 struct FastDrive;
 impl System<2> for FastDrive {

@@ -3,8 +3,9 @@
 
 mod link_samples;
 
+use kapitza_core::checksum::CRC;
 use kapitza_core::link::frame::{
-    self, encode, max_frame_len, receive_request, receive_response, Header, CRC,
+    self, encode, max_frame_len, receive_request, receive_response, Header,
 };
 use kapitza_core::link::message::{Mode, RMethod, StopReason, Telemetry, WireGeometry};
 use kapitza_core::link::{

@@ -3,7 +3,6 @@
 
 use kapitza_core::link::convert::{deg_along_travel, from_q16, to_q16};
 use kapitza_core::link::message::{Counters, Fault, Mode};
-use kapitza_core::link::serve::{apply, config_change_allowed, status, Clock, Command, RigServer};
 use kapitza_core::link::{Reason, Request};
 use kapitza_core::persist::{ConfigOrigin, Fallback};
 use kapitza_core::rig::config::RigConfig;
@@ -12,6 +11,9 @@ use kapitza_core::rig::estimator::Tuning;
 use kapitza_core::rig::fixed::{Amps, Angle, Duty};
 use kapitza_core::rig::phase_lock::Motor;
 use kapitza_core::rig::safety;
+use kapitza_core::station::serve::{
+    apply, config_change_allowed, status, Clock, Command, RigServer,
+};
 
 const CFG: RigConfig = RigConfig::REFERENCE;
 
@@ -53,7 +55,7 @@ fn set_drive_starts_then_changes_omega() {
     .unwrap();
     let sup = r.supervisor();
     assert_eq!(sup.mode(), safety::Mode::Running);
-    // ω = ωc √3 (SPEC §3; 313.2 rad/s for the reference rig, RigConfig's own test).
+    // ω = ωc √3 (physics §3; 313.2 rad/s for the reference rig, RigConfig's own test).
     let w = kapitza_core::rig::dds::omega_of_word(sup.target_word());
     assert!((w - CFG.omega_for_r(3.0).unwrap()).abs() < 1e-3, "{w}");
     assert_eq!(sup.theta_d_target(), Angle::HALF_TURN);
@@ -306,8 +308,8 @@ fn reasons_read_well() {
 
 mod server {
     use super::*;
-    use kapitza_core::link::serve::Effect;
     use kapitza_core::link::{Response, VersionInfo, WireConfig};
+    use kapitza_core::station::serve::Effect;
 
     fn server() -> RigServer {
         RigServer::new(
@@ -418,7 +420,7 @@ mod server {
             },
         )
         .unwrap();
-        s.activity = kapitza_core::link::serve::Activity::None;
+        s.activity = kapitza_core::station::serve::Activity::None;
         let (r, _) = s.respond(Request::SetConfig(new.into()), Clock::single(30, 0), false);
         assert_eq!(r, Response::Refused(Reason::WrongMode(Mode::Running)));
         assert_eq!(s.cfg, CFG);

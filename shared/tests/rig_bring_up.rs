@@ -5,9 +5,9 @@
 mod sim_bench;
 
 use kapitza_core::link::message::{Fault, Mode, RawTelemetry};
-use kapitza_core::link::serve::BRING_UP_DUTY_MAX;
 use kapitza_core::link::{Reason, Request, Response};
 use kapitza_core::simrig::Params;
+use kapitza_core::station::serve::BRING_UP_DUTY_MAX;
 use sim_bench::Bench;
 
 /// A duty in I1F15 bits.

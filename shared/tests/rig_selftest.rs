@@ -1,9 +1,9 @@
-//! The on-target scenarios (`rig::selftest`, `station::selftest`) on the host: each must produce its expected digest,
+//! The on-target scenarios (`selftest::rig`, `selftest::station`) on the host: each must produce its expected digest,
 //! the same one the emulated Cortex-M4F must produce (`qemu/`), so host and target agree bit
 //! for bit. Prints every digest (`-- --nocapture`) for regeneration after a deliberate change.
 
-use kapitza_core::rig::selftest::CASES;
-use kapitza_core::station::selftest::CASES as LOOP_CASES;
+use kapitza_core::selftest::rig::CASES;
+use kapitza_core::selftest::station::CASES as LOOP_CASES;
 
 #[test]
 fn digests_match() {

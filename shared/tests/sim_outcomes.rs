@@ -1,4 +1,4 @@
-//! The simulator against closed forms and the averaged theory (SPEC §3–5).
+//! The simulator against closed forms and the averaged theory (physics §3–5).
 
 use kapitza_core::math;
 use kapitza_core::model::{equilibria, DriveAngle, Geometry};
@@ -40,7 +40,7 @@ fn rest_deg(o: Outcome) -> f64 {
 fn tilted_rest_matches_averaged_equilibrium() {
     let scene = tilted();
     let p = scene.physical().unwrap();
-    // Averaged theory (SPEC §3): the stable equilibrium within 90° of θd = 135°.
+    // Averaged theory (physics §3): the stable equilibrium within 90° of θd = 135°.
     let eq = equilibria(p.r, scene.drive.angle).unwrap();
     let want = eq
         .stable()

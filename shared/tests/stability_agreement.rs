@@ -1,4 +1,4 @@
-//! How far each cheaper level is from the Floquet reference (SPEC §4: "report how far each
+//! How far each cheaper level is from the Floquet reference (physics §4: "report how far each
 //! cheaper criterion is from it"). Every tolerance is the difference measured when the test was
 //! written (1000 RK4 steps per period, ends bisected to 1e-12; Floquet's own error ≤ 1.5e-10),
 //! rounded up by about 20 %: a regression in any level moves its number past it.
@@ -54,7 +54,7 @@ fn inverted_windows() {
             tol[5],
             "HB truncated upper",
         );
-        // The SPEC's ordering: each cheaper level is less accurate.
+        // The ordering of physics §4: each cheaper level is less accurate.
         assert!(
             avg > mat_l && mat_l > hb_l,
             "k = {k}: lower ends out of order"

@@ -1,4 +1,4 @@
-//! Every stability value of the SPEC §4 reference table, at each level that produces it, and the
+//! Every stability value of the physics §4 reference table, at each level that produces it, and the
 //! Floquet reference next to it. Printed values are checked to half a unit of their last printed
 //! digit; where Floquet disagrees with a printed value by more than that, the test pins the
 //! measured Floquet value instead and says so.
@@ -21,18 +21,18 @@ fn value(e: End) -> f64 {
 #[test]
 fn k_minus_0_3() {
     let k = -0.3;
-    // SPEC §4: conventional lower bound √(−2k) = 0.775 (printed to 3 decimals; exact 0.774597).
+    // physics §4: conventional lower bound √(−2k) = 0.775 (printed to 3 decimals; exact 0.774597).
     close(averaging::lower(k).unwrap(), 0.775, 5e-4, "averaging lower");
-    // SPEC §4: improved lower bound 0.868 (closed form 0.8681635).
+    // physics §4: improved lower bound 0.868 (closed form 0.8681635).
     close(
         hb::improved_lower(k).unwrap(),
         0.868,
         5e-4,
         "improved lower",
     );
-    // SPEC §4: upper (flutter) bound 0.929 (3×3 cubic: 0.9286809).
+    // physics §4: upper (flutter) bound 0.929 (3×3 cubic: 0.9286809).
     close(hb::flutter_upper(k).unwrap(), 0.929, 5e-4, "flutter upper");
-    // SPEC §4: order-8 subharmonic threshold from the 5×5 system, 0.8773 (quintic: 0.8772651).
+    // physics §4: order-8 subharmonic threshold from the 5×5 system, 0.8773 (quintic: 0.8772651).
     close(
         value(hb::subharmonic_m(k, 8).unwrap()),
         0.8773,
@@ -56,11 +56,11 @@ fn k_minus_0_3() {
 #[test]
 fn k_minus_0_5() {
     let k = -0.5;
-    // SPEC §4: improved lower bound (formula) 1.19208, printed as 1.1920 (the formula gives
+    // physics §4: improved lower bound (formula) 1.19208, printed as 1.1920 (the formula gives
     // 1.1920791: the printed figure is truncated, not rounded).
     let lo = hb::improved_lower(k).unwrap();
     close(lo, 1.19208, 5e-6, "improved lower");
-    // SPEC §4: upper bound from the cubic 1.2226 and from the truncated formula 1.2265.
+    // physics §4: upper bound from the cubic 1.2226 and from the truncated formula 1.2265.
     close(hb::flutter_upper(k).unwrap(), 1.2226, 5e-5, "cubic upper");
     close(
         value(hb::truncated_upper(k).unwrap()),
@@ -88,7 +88,7 @@ fn k_minus_0_5() {
 
 #[test]
 fn k_zero() {
-    // SPEC §4: truncated formula 3(√13 − 3)/4 = 0.45416 (closed form; 0.4541634566).
+    // physics §4: truncated formula 3(√13 − 3)/4 = 0.45416 (closed form; 0.4541634566).
     let t = value(hb::truncated_upper(0.0).unwrap());
     close(
         t,
@@ -97,7 +97,7 @@ fn k_zero() {
         "truncated vs closed form",
     );
     close(t, 0.45416, 5e-6, "truncated vs printed");
-    // SPEC §4: 3×3 determinant 0.4540 (cubic root 0.4540233).
+    // physics §4: 3×3 determinant 0.4540 (cubic root 0.4540233).
     close(
         hb::flutter_upper(0.0).unwrap(),
         0.4540,
@@ -112,7 +112,7 @@ fn k_zero() {
 
 #[test]
 fn landau_row() {
-    // SPEC §4: g = 9.81, l = 1 m, ω = 9 rad/s, undamped: Landau's lower bound on the pivot
+    // physics §4: g = 9.81, l = 1 m, ω = 9 rad/s, undamped: Landau's lower bound on the pivot
     // amplitude a is 0.492 m. For a point mass on a 1 m rod m = a/l = a, and averaging gives
     // a > √(2g/(lω²)) = √(2·9.81/81) = 0.49216 (Landau & Lifshitz, Mechanics §30, problem 1).
     let (g, l, w) = (9.81, 1.0, 9.0);

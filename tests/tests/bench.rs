@@ -193,7 +193,7 @@ fn physical_question_and_ladders_are_answered() {
             );
         }
     }
-    // At k = −0.3 the ladder is ordered as SPEC §4 says: each cheaper level less accurate.
+    // At k = −0.3 the ladder is ordered as physics §4 says: each cheaper level less accurate.
     let err = |name: &str| {
         arr(&v["stability_criteria"])
             .iter()

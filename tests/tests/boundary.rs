@@ -1,4 +1,4 @@
-//! `kapitza boundary`, run in-process as a user would call it, against the SPEC §4 table.
+//! `kapitza boundary`, run in-process as a user would call it, against the physics §4.5.
 
 use kapitza_core::cases::{self, BoundaryCase};
 use serde_json::Value;
@@ -24,7 +24,7 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-/// Checks every printed value of one SPEC row against the matching criterion (each printed value
+/// Checks every printed value of one reference-table row (physics §4.5) against the matching criterion (each printed value
 /// must round to what we compute: tolerance half a unit in its last printed place).
 fn check_case(case: &BoundaryCase) {
     let k = case.k.to_string();
@@ -85,9 +85,9 @@ fn spec_rows() {
 
 #[test]
 fn floquet_matches_the_printed_boundaries() {
-    // The Floquet reference rounds to the SPEC's printed window ends at k = −0.3 (0.868, 0.929)
+    // The Floquet reference rounds to the reference table's printed window ends at k = −0.3 (0.868, 0.929)
     // and to the cubic value at k = 0 (0.4540). At k = −0.5 it gives 1.19182 for the lower end,
-    // which the SPEC prints as the formula's 1.19208 — see docs/stability.md.
+    // which the reference table prints as the formula's 1.19208 — see docs/stability.md.
     let v = boundary(&["--k", "-0.3"]);
     let f = criterion(&v, "floquet");
     assert!(cases::K_MINUS_0_3
@@ -112,7 +112,7 @@ fn floquet_matches_the_printed_boundaries() {
 
 #[test]
 fn landau_amplitude_in_metres() {
-    // SPEC §4 table (Landau & Lifshitz): g = 9.81, l = 1 m, ω = 9 rad/s → lower bound on the
+    // physics §4.5 (Landau & Lifshitz): g = 9.81, l = 1 m, ω = 9 rad/s → lower bound on the
     // amplitude 0.492 m from averaging; given a pendulum, ends are also reported in metres.
     let l = cases::LANDAU;
     let v = boundary(&["--point", "1", "--omega", "9"]);
@@ -124,13 +124,13 @@ fn landau_amplitude_in_metres() {
         a["lower_amplitude"]
     );
     assert!(a["upper_amplitude"].is_null() && a["upper_reason"].is_string());
-    // k = −g/(ℓω²) (SPEC §3).
+    // k = −g/(ℓω²) (physics §3).
     assert!((num(&v["k"]) + 9.81 / 81.0).abs() < 1e-15);
 }
 
 #[test]
 fn damping_enters_floquet_only() {
-    // δ = √|k|/Q (SPEC §3). Floquet's window narrows from below with damping; the others keep
+    // δ = √|k|/Q (physics §3). Floquet's window narrows from below with damping; the others keep
     // their undamped values and say so.
     let undamped = boundary(&["--k", "-0.3"]);
     let damped = boundary(&["--k", "-0.3", "--q", "5"]);
@@ -252,7 +252,7 @@ fn omega_window_for_a_given_stroke() {
     // Units: Hz = ω/2π, rpm = 60 Hz.
     assert!((num(&w["lower"]["hz"]) * std::f64::consts::TAU - lo).abs() < 1e-12 * lo);
     assert!((num(&w["lower"]["rpm"]) - 60.0 * num(&w["lower"]["hz"])).abs() < 1e-9);
-    // ωc = √(2gℓ)/A (SPEC §3), ℓ = 2L/3.
+    // ωc = √(2gℓ)/A (physics §3), ℓ = 2L/3.
     let wc = (2.0 * 9.81 * 0.25 * 2.0 / 3.0f64).sqrt() / 0.09;
     assert!((num(&w["omega_c"]) - wc).abs() < 1e-12 * wc);
     // The demo rod's stroke (m = 0.076) never flutters: no upper end.

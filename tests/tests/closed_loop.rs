@@ -34,7 +34,7 @@ fn run_case(c: &Case) -> Outcome {
     let cfg = RigConfig::REFERENCE;
     let omega = cfg.omega_for_r(c.r).unwrap();
     let d = DriveAngle::from_deg(c.theta_d).unwrap();
-    // Truth: the averaged theory (SPEC §3) at the R the drive generator actually produces.
+    // Truth: the averaged theory (physics §3) at the R the drive generator actually produces.
     let r_true = cfg.r_for_omega(omega_of_word(
         kapitza_core::rig::dds::word_from_omega(omega).unwrap(),
     ));
@@ -138,7 +138,7 @@ fn check(name: &str, c: Case, method: RMethod) {
 
 #[test]
 fn horizontal_drive_90() {
-    // R = 1.75, θd = 90°: φ0 = arccos(1/R) = 55.15° (SPEC §3, §4 table).
+    // R = 1.75, θd = 90°: φ0 = arccos(1/R) = 55.15° (physics §3, §4 table).
     check(
         "horizontal",
         Case {
@@ -183,7 +183,7 @@ fn hc15_inverted_180_singular() {
 
 #[test]
 fn hc15_hanging_0_singular() {
-    // θd = 0°, R = 1: φ0 = 0, ωp = ω0√(1 + R) (SPEC §3).
+    // θd = 0°, R = 1: φ0 = 0, ωp = ω0√(1 + R) (physics §3).
     check(
         "hanging (singular)",
         Case {

@@ -1,4 +1,4 @@
-//! θd and θd + 180° are the same shaking line half a drive period apart (SPEC §3: only 2θd
+//! θd and θd + 180° are the same shaking line half a drive period apart (physics §3: only 2θd
 //! enters), so with a purely sinusoidal drive and no ramp a settled outcome must not change its
 //! kind between them. The scenes here are the shipped ones whose attractor does not depend on
 //! the release phase (measured: `kapitza simulate FILE --set drive.angle_deg=θd±180 --json`;
@@ -50,7 +50,7 @@ fn outcome_kind_is_the_same_half_a_period_later() {
 
 #[test]
 fn shipped_flutter_scene_flutters_about_180_at_drive_angle_0() {
-    // The flutter scene's expectation (flutter about 180°, SPEC §4 upper boundary) holds for the
+    // The flutter scene's expectation (flutter about 180°, physics §4 upper boundary) holds for the
     // same shaking line strobed half a period later.
     let v = run("flutter.toml", 0.0);
     assert_eq!(v["outcome"]["kind"], "flutter", "{}", v["outcome"]);

@@ -1,4 +1,4 @@
-//! `kapitza predict`, run in-process as a user would call it, checked against SPEC §3–4.
+//! `kapitza predict`, run in-process as a user would call it, checked against physics §3–4.
 
 use serde_json::Value;
 
@@ -22,7 +22,7 @@ fn stable_angles(v: &Value) -> Vec<f64> {
 
 #[test]
 fn horizontal_drive_lists_both_tilts() {
-    // SPEC §4 table: R = 1.75, θd = 90° → stable φ0 = ±arccos(1/R) = ±55.15° (closed form;
+    // physics §4.5: R = 1.75, θd = 90° → stable φ0 = ±arccos(1/R) = ±55.15° (closed form;
     // 1e-9° is rounding), both listed; only +55.15° is within 90° of the drive.
     let v = predict(&["--r", "1.75", "--angle", "90"]);
     let want = (1.0f64 / 1.75).acos().to_degrees();
@@ -45,7 +45,7 @@ fn horizontal_drive_lists_both_tilts() {
 
 #[test]
 fn inverted_needs_r_above_one() {
-    // SPEC §3: θd = 180° → inverted stable iff R > 1, ωp = ω0 √(R − 1).
+    // physics §3: θd = 180° → inverted stable iff R > 1, ωp = ω0 √(R − 1).
     let v = predict(&["--r", "1.5", "--angle", "180"]);
     let inv = v["equilibria"]
         .as_array()
@@ -61,7 +61,7 @@ fn inverted_needs_r_above_one() {
 
 #[test]
 fn rod_geometry_matches_spec_r() {
-    // SPEC §4 table: rod L = 0.25 m, A = 0.0127 m, ω = 188 rad/s, g = 9.81 → R = 1.7433 (4 d.p.).
+    // physics §4.5: rod L = 0.25 m, A = 0.0127 m, ω = 188 rad/s, g = 9.81 → R = 1.7433 (4 d.p.).
     let v = predict(&[
         "--rod",
         "0.25",
@@ -80,7 +80,7 @@ fn rod_geometry_matches_spec_r() {
 
 #[test]
 fn saddle_node_point_is_marginal() {
-    // SPEC §4 table: at R = 2, θd = 135° the equilibrium within 90° of the drive is marginal.
+    // physics §4.5: at R = 2, θd = 135° the equilibrium within 90° of the drive is marginal.
     let v = predict(&["--r", "2", "--angle", "135"]);
     let m: Vec<&Value> = v["equilibria"]
         .as_array()
@@ -160,14 +160,14 @@ fn bad_input_names_the_argument() {
 
 #[test]
 fn rest_angle_answers_which_drive_angle() {
-    // Closed forms (SPEC §3 solved for θd): a rest at φ0 needs |sin 2(φ0 − θd)| = 2|sin φ0|/R
+    // Closed forms (physics §3 solved for θd): a rest at φ0 needs |sin 2(φ0 − θd)| = 2|sin φ0|/R
     // ≤ 1, so R ≥ 2 sin φ0, reached at φ0 − θd = −45° where the margin cos φ0 > 0 for
     // φ0 = 60°; R is unbounded above (θd → φ0). Tolerance 1e-8: the scan over φ0 − θd is
     // flat (quadratic) at its minimum.
     let v = predict(&["--rest-angle", "60"]);
     assert!((v["r_min"].as_f64().unwrap() - 2.0 * 60f64.to_radians().sin()).abs() < 1e-8);
     assert!(v["r_max"].is_null());
-    // R = 1.75: the equilibrium at arccos(1/R) = 55.15° needs θd = 90° (SPEC §4 table); the
+    // R = 1.75: the equilibrium at arccos(1/R) = 55.15° needs θd = 90° (physics §4.5); the
     // other root of sin 2x (θd = 110.3°) is unstable there, and the x + 180° roots unreachable.
     let phi = (1.0f64 / 1.75).acos().to_degrees();
     let v = predict(&["--rest-angle", &phi.to_string(), "--r", "1.75"]);

@@ -48,7 +48,7 @@ fn settling_and_slider_crank_reach_the_reference() {
 
 #[test]
 fn flutter_scene_flutters_with_rkn() {
-    // The shipped expectation (flutter about 180°, SPEC §4) with the other method.
+    // The shipped expectation (flutter about 180°, physics §4) with the other method.
     let v = shipped::simulate("flutter.toml", &["run.method=rkn86"]);
     assert_eq!(v["outcome"]["kind"], "flutter", "{}", v["outcome"]);
     assert_eq!(v["expect"]["met"], true, "{}", v["expect"]);

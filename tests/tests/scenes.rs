@@ -1,6 +1,6 @@
 //! Every shipped scene in `scenes/` gives the outcome its `[expect]` table states.
 //!
-//! The expectations name their sources in each file (closed forms of SPEC §3, the SPEC §4 table,
+//! The expectations name their sources in each file (closed forms of physics §3, the physics §4.5,
 //! Floquet boundaries from `kapitza boundary`); this test runs them exactly as a user would,
 //! `kapitza simulate FILE --check`.
 
@@ -20,7 +20,7 @@ fn scenes() -> Vec<PathBuf> {
 #[test]
 fn every_shipped_scene_meets_its_expectation() {
     let files = scenes();
-    // One per outcome kind and per simulable SPEC claim: guard against the directory emptying.
+    // One per outcome kind and per simulable claim of docs/physics.md: guard against the directory emptying.
     assert!(files.len() >= 15, "{} scenes", files.len());
     let mut kinds = std::collections::BTreeSet::new();
     for f in &files {

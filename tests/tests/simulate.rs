@@ -96,7 +96,7 @@ fn json_has_the_documented_keys() {
 fn averaged_rod_rests_at_the_predicted_equilibrium() {
     // R = 3 at θd = 135°, start 100°: the averaged theory's stable equilibrium within 90° of the
     // drive is 116.728° (kapitza predict --r 3 --angle 135, the root of
-    // sin φ + (R/2) sin 2(φ − θd) = 0, SPEC §3). The averaged run converges to it exactly, so the
+    // sin φ + (R/2) sin 2(φ − θd) = 0, physics §3). The averaged run converges to it exactly, so the
     // classifier's resolution is the tolerance.
     let v = simulate("sim_averaged_rest.toml", &[]);
     assert_eq!(v["outcome"]["kind"], "rest");
@@ -118,7 +118,7 @@ fn averaged_rod_rests_at_the_predicted_equilibrium() {
 #[test]
 fn full_equation_keeps_the_inverted_position() {
     // θd = 180°, R = 2 > 1: θ = π is an exact fixed point of the full equation and stable
-    // (SPEC §3), so the run rests at 180° to the classifier's resolution.
+    // (physics §3), so the run rests at 180° to the classifier's resolution.
     let v = simulate("sim_full_sensor.toml", &[]);
     assert_eq!(v["outcome"]["kind"], "rest");
     assert!(wrap_deg(f(&v, "/outcome/angle_deg") - 180.0).abs() < TOL_DEG);
@@ -129,7 +129,7 @@ fn full_equation_keeps_the_inverted_position() {
     // Fixed-step RK4: exactly 40 steps in each of the 600 periods, none rejected.
     assert_eq!(v["work"]["steps"], 600 * 40);
     assert_eq!(v["work"]["rejected"], 0);
-    // Under the 20° tilt R and ω0 use g cos β (SPEC §5); R stays as given, ω follows.
+    // Under the 20° tilt R and ω0 use g cos β (physics §5); R stays as given, ω follows.
     let g_eff = 9.81 * 20f64.to_radians().cos();
     assert!((f(&v, "/gravity_effective") - g_eff).abs() < 1e-12);
     assert!((f(&v, "/omega0") - (g_eff / (2.0 * 0.2 / 3.0)).sqrt()).abs() < 1e-12);
@@ -138,7 +138,7 @@ fn full_equation_keeps_the_inverted_position() {
 
 #[test]
 fn set_overrides_a_key() {
-    // At θd = 90° the stable tilted equilibria are ±arccos(1/R) (closed form, SPEC §3); from
+    // At θd = 90° the stable tilted equilibria are ±arccos(1/R) (closed form, physics §3); from
     // 100° the pendulum settles at +arccos(1/3) = 70.53°.
     let v = simulate("sim_averaged_rest.toml", &["--set", "drive.angle_deg=90"]);
     assert_eq!(v["drive_angle_deg"], 90.0);
@@ -153,7 +153,7 @@ fn set_overrides_a_key() {
 #[test]
 fn set_adds_an_effect() {
     // The averaged scene has no tilt; --set adds one. R is given, so ω follows from
-    // R = A²ω²/(2 g cos β ℓ): ω scales with √cos β (SPEC §5, closed form).
+    // R = A²ω²/(2 g cos β ℓ): ω scales with √cos β (physics §5, closed form).
     let plain = simulate("sim_averaged_rest.toml", &[]);
     let tilted = simulate(
         "sim_averaged_rest.toml",
@@ -183,7 +183,7 @@ fn set_adds_an_effect() {
             "run.fidelity=auto",
         ],
     );
-    // c = 2γ (SPEC §3).
+    // c = 2γ (physics §3).
     assert!((f(&v, "/damping_c") - 6.0).abs() < 1e-12);
     assert_eq!(v["fidelity"]["requested"], "auto");
     // ω/ω0 ≈ 37 ≥ 10 and A/ℓ = 0.067 ≤ 0.1: auto picks the averaged model and says why.

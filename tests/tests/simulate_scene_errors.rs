@@ -260,7 +260,7 @@ fn out_of_range_numbers() {
 
 #[test]
 fn combinations_that_cannot_run() {
-    // The linearised model exists only about an exact fixed point (θd = 0° or 180°, SPEC §5).
+    // The linearised model exists only about an exact fixed point (θd = 0° or 180°, physics §5).
     let msg = error(
         &GOOD.replace("periods = 300", "periods = 300\nfidelity = \"linearised\""),
         &[],

@@ -1,4 +1,4 @@
-//! The stability-criteria ladder (SPEC §4): for a sweep of k about the inverted (k < 0) and the
+//! The stability-criteria ladder (physics §4): for a sweep of k about the inverted (k < 0) and the
 //! hanging (k > 0) position, undamped, each cheaper criterion's window ends against Floquet's,
 //! with the cost of one evaluation of the window; and Floquet's own error against its cost as
 //! the RK4 steps per period grow, measured against a finer Floquet reference.

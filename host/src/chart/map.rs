@@ -18,7 +18,7 @@ pub fn samples(from: f64, to: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// How damping enters: none, or a quality factor Q (δ = √|k|/Q, SPEC §3).
+/// How damping enters: none, or a quality factor Q (δ = √|k|/Q, physics §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Damping {
     None,

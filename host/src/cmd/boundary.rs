@@ -1,4 +1,4 @@
-//! `kapitza boundary`: the stability window in m = A/ℓ from every criterion of SPEC §4, each
+//! `kapitza boundary`: the stability window in m = A/ℓ from every criterion of physics §4, each
 //! with its difference from Floquet and its measured cost.
 
 mod omega;

@@ -28,7 +28,7 @@ pub struct RigFile {
 }
 
 impl RigFile {
-    /// The demo rod (SPEC §4) configured as it is.
+    /// The demo rod (physics §4) configured as it is.
     pub fn demo() -> Self {
         Self {
             title: "the demo rod (L = 0.25 m, A = 12.7 mm)".into(),

@@ -2,9 +2,9 @@
 //! computation as `kapitza predict`, narrowed to the equilibrium a demo rig can reach.
 //!
 //! ```text
-//! φ0: the stable equilibrium within 90° of the drive direction θd (SPEC §3: the actuator body
+//! φ0: the stable equilibrium within 90° of the drive direction θd (physics §3: the actuator body
 //!     keeps the rod from the others); the nearest to θd if there are two
-//! ωp = ω0 √(cos φ0 + R cos 2(φ0 − θd))      (SPEC §3)
+//! ωp = ω0 √(cos φ0 + R cos 2(φ0 − θd))      (physics §3)
 //! ```
 
 use kapitza_core::math;
@@ -65,18 +65,18 @@ mod tests {
     #[test]
     fn closed_forms() {
         let cfg = Params::DEMO.configured();
-        // SPEC §3: θd = 90°, R > 1 → φ0 = arccos(1/R) = 55.15° at R = 1.75.
+        // physics §3: θd = 90°, R > 1 → φ0 = arccos(1/R) = 55.15° at R = 1.75.
         let p = predict(&cfg, 1.75, 90.0).unwrap();
         assert!((p.phi0_deg - (1.0f64 / 1.75).acos().to_degrees()).abs() < 1e-6);
-        // SPEC §3: θd = 180°: inverted, ωp = ω0 √(R − 1); rod ω0 = √(3g/(2L)).
+        // physics §3: θd = 180°: inverted, ωp = ω0 √(R − 1); rod ω0 = √(3g/(2L)).
         let p = predict(&cfg, 2.2, 180.0).unwrap();
         let w0 = (3.0 * 9.81 / (2.0 * 0.25f64)).sqrt();
         assert!((p.phi0_deg.abs() - 180.0).abs() < 1e-6);
         assert!((p.omega_p - w0 * 1.2f64.sqrt()).abs() < 1e-9 * w0);
-        // SPEC §3: at rest (R = 0) the pendulum hangs, ωp = ω0.
+        // physics §3: at rest (R = 0) the pendulum hangs, ωp = ω0.
         let p = predict(&cfg, 0.0, 90.0).unwrap();
         assert!(p.phi0_deg.abs() < 1e-9 && (p.omega_p - w0).abs() < 1e-9 * w0);
-        // SPEC §3: R_sn(150°) = (0.5^(2/3) + 0.866^(2/3))^(3/2) = 1.908 > 1.75, so only two
+        // physics §3: R_sn(150°) = (0.5^(2/3) + 0.866^(2/3))^(3/2) = 1.908 > 1.75, so only two
         // equilibria; the equilibrium condition changes sign between φ = −30° (−0.5) and 0°
         // (+0.758), so the stable one hangs there, more than 90° from the drive.
         assert!(predict(&cfg, 1.75, 150.0).is_none());

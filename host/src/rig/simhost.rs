@@ -21,10 +21,10 @@ use std::time::{Duration, Instant};
 
 use kapitza_core::link::convert::deg_along_travel;
 use kapitza_core::link::message::Check;
-use kapitza_core::link::serve::{Activity, RigServer};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::dds::omega_of_word;
 use kapitza_core::simrig::SimRig;
+use kapitza_core::station::serve::{Activity, RigServer};
 use serde::Serialize;
 
 use super::file::RigFile;

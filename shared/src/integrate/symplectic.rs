@@ -4,7 +4,7 @@
 //! Why: a symplectic method integrates a nearby Hamiltonian system exactly (up to rounding), so
 //! its energy error stays bounded and oscillates instead of drifting, for exponentially long
 //! times (HNW, *Geometric Numerical Integration*, 2nd ed. 2006, §IX.8). Over 10⁶ drive periods
-//! (SPEC §6) that matters more than the local error: a non-symplectic method such as RK4 lets the
+//! (physics §6) that matters more than the local error: a non-symplectic method such as RK4 lets the
 //! energy decay steadily at any step size.
 //!
 //! # Störmer–Verlet (velocity form, kick–drift–kick)

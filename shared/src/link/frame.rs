@@ -26,8 +26,7 @@ use super::message::{Request, Response, VersionInfo};
 use super::reason::Reason;
 use super::PROTOCOL_VERSION;
 
-/// The CRC: CRC-32C (Castagnoli), as used by iSCSI.
-pub const CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
+use crate::checksum::CRC;
 
 /// Bytes before the payload: version, seq.
 pub const HEADER_LEN: usize = 2;

@@ -21,8 +21,8 @@
 use postcard::experimental::max_size::MaxSize;
 use serde::{Deserialize, Serialize};
 
+use super::origin::ConfigOrigin;
 use super::reason::Reason;
-use crate::persist::ConfigOrigin;
 
 /// Raw bits of an I16F16 value (unit given where it is used).
 pub type Q16 = i32;

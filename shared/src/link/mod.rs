@@ -1,5 +1,6 @@
-//! The serial link between the laptop and the rig: typed messages, framing, refusal reasons, and
-//! the rig's side of the conversation. Shared by the firmware and the host, tested on the host.
+//! The serial link between the laptop and the rig: typed messages, framing and refusal reasons.
+//! Shared by the firmware and the host, tested on the host. The rig's side of the conversation,
+//! which answers the messages, is [`crate::station::serve`].
 //!
 //! | module | concept |
 //! |---|---|
@@ -7,7 +8,7 @@
 //! | [`frame`] | version ‖ seq ‖ postcard ‖ CRC-32C, COBS-stuffed, zero-terminated; the frame reader |
 //! | [`reason`] | [`Reason`]: why a frame or a command was refused, with stable codes and text |
 //! | [`convert`] | the rig's types ↔ their wire images; I16F16 and degree conversions |
-//! | [`serve`] | the rig's side: [`serve::RigServer`] answers every request; commands all or nothing, status and telemetry built |
+//! | [`origin`] | where the configuration in use came from, and why a stored one was not used |
 //!
 //! The laptop's side is the host tool's `link` module: one method per command, and an error type
 //! that keeps "the line failed" apart from "the rig refused".
@@ -74,8 +75,8 @@
 pub mod convert;
 pub mod frame;
 pub mod message;
+pub mod origin;
 pub mod reason;
-pub mod serve;
 
 pub use frame::{FrameReader, Header, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 pub use message::{Request, Response, Status, Telemetry, VersionInfo, WireConfig};

@@ -1,11 +1,11 @@
-//! The drive: the pivot moves as `r_p(t) = A cos(ωt) · (sin θd, −cos θd)` (SPEC §2).
+//! The drive: the pivot moves as `r_p(t) = A cos(ωt) · (sin θd, −cos θd)` (physics §2).
 
 use crate::error::{finite, non_negative, positive, ParamError};
 use crate::math;
 
 /// The drive angle θd with its sine and cosine, exact at multiples of 90° when built from degrees.
 ///
-/// The special cases of SPEC §3 (θd = 0°, 90°, 180°) are exact symmetries; computing sin(π) in
+/// The special cases of physics §3 (θd = 0°, 90°, 180°) are exact symmetries; computing sin(π) in
 /// floating point gives 1.2e-16 instead of 0 and breaks them, so the pair is kept alongside.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DriveAngle {

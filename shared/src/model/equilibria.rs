@@ -1,4 +1,4 @@
-//! Every equilibrium of the averaged motion, with its stability (SPEC §3).
+//! Every equilibrium of the averaged motion, with its stability (physics §3).
 //!
 //! ```text
 //! equilibrium:  f(φ) = sin φ + (R/2) sin 2(φ − θd) = 0
@@ -48,7 +48,7 @@ pub struct Equilibrium {
     /// ωp/ω0 = √s for a stable equilibrium.
     pub omega_p_over_omega0: Option<f64>,
     /// Within 90° of the drive direction θd, i.e. reachable on an apparatus whose actuator body
-    /// sits on the other side of the pivot (SPEC §3).
+    /// sits on the other side of the pivot (physics §3).
     pub within_90_of_drive: bool,
 }
 
@@ -200,12 +200,12 @@ mod tests {
 
     #[test]
     fn vertical_drive_closed_forms() {
-        // SPEC §3: θd = 0 → φ0 = 0 stable with ωp = ω0 √(1 + R); for R > 1 also cos φ = −1/R.
+        // physics §3: θd = 0 → φ0 = 0 stable with ωp = ω0 √(1 + R); for R > 1 also cos φ = −1/R.
         let e = eq(0.5, 0.0);
         assert_eq!(e.len(), 2);
         let hang = e.as_slice().find(|e| e.angle.abs() < 1e-12).unwrap();
         assert!((hang.omega_p_over_omega0.unwrap() - 1.5f64.sqrt()).abs() < 1e-12);
-        // SPEC §3: θd = 180° → inverted stable iff R > 1, ωp = ω0 √(R − 1).
+        // physics §3: θd = 180° → inverted stable iff R > 1, ωp = ω0 √(R − 1).
         let e = eq(3.0, 180.0);
         assert_eq!(e.len(), 4);
         let inv = e
@@ -224,7 +224,7 @@ mod tests {
 
     #[test]
     fn horizontal_drive() {
-        // SPEC §4 table: R = 1.75, θd = 90° → stable φ0 = ±arccos(1/R) = ±55.15°.
+        // physics §4.5: R = 1.75, θd = 90° → stable φ0 = ±arccos(1/R) = ±55.15°.
         let e = eq(1.75, 90.0);
         let want = math::to_deg(math::acos(1.0 / 1.75));
         assert!((want - 55.15).abs() < 0.005);
@@ -248,7 +248,7 @@ mod tests {
 
     #[test]
     fn merging_points_are_marginal() {
-        // R_sn(135°) = 2 and R_sn(90°) = 1 (closed form of the astroid, SPEC §3).
+        // R_sn(135°) = 2 and R_sn(90°) = 1 (closed form of the astroid, physics §3).
         let d135 = DriveAngle::from_deg(135.0).unwrap();
         assert!((saddle_node_r(d135) - 2.0).abs() < 1e-12);
         let e = eq(2.0, 135.0);

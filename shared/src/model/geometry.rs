@@ -84,7 +84,7 @@ mod tests {
 
     #[test]
     fn equivalent_lengths() {
-        // Closed forms, SPEC §2: rod ℓ = 2L/3, point mass ℓ = l.
+        // Closed forms, physics §2: rod ℓ = 2L/3, point mass ℓ = l.
         assert!((Geometry::rod(0.3).unwrap().equivalent_length() - 0.2).abs() < 1e-15);
         assert_eq!(Geometry::point_mass(0.7).unwrap().equivalent_length(), 0.7);
         // A rod described as a general body (I = mL²/3, z = L/2) must agree with the rod.

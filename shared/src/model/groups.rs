@@ -1,4 +1,4 @@
-//! The dimensionless groups of SPEC §3.
+//! The dimensionless groups of physics §3.
 //!
 //! ```text
 //! ω0 = √(g/ℓ)                  natural frequency
@@ -85,7 +85,7 @@ impl Groups {
     }
 }
 
-/// ω that gives drive strength R: ω = ωc √R (SPEC §7, "setting R means computing ω").
+/// ω that gives drive strength R: ω = ωc √R (physics §7, "setting R means computing ω").
 pub fn omega_for_r(r: f64, ell: f64, gravity: f64, amplitude: f64) -> Result<f64, ParamError> {
     let r = positive("R", r)?;
     let ell = positive("equivalent length", ell)?;
@@ -109,7 +109,7 @@ mod tests {
 
     #[test]
     fn spec_rod_example() {
-        // SPEC §4 table: rod L = 0.25 m, A = 0.0127 m, ω = 188 rad/s, g = 9.81 → R = 1.7433
+        // physics §4.5: rod L = 0.25 m, A = 0.0127 m, ω = 188 rad/s, g = 9.81 → R = 1.7433
         // (closed form 3A²ω²/(4gL) = 1.74332…; tolerance 5e-5 covers the 4 printed decimals).
         let ell = 2.0 * 0.25 / 3.0;
         let g = Groups::new(ell, 9.81, 0.0127, 188.0, 0.0).unwrap();
@@ -120,7 +120,7 @@ mod tests {
 
     #[test]
     fn identities() {
-        // R = m²/(2|k|) = (ω/ωc)², Q·δ = √|k| (SPEC §3), to rounding.
+        // R = m²/(2|k|) = (ω/ωc)², Q·δ = √|k| (physics §3), to rounding.
         let g = Groups::new(0.17, 9.81, 0.009, 330.0, 0.8).unwrap();
         assert!((g.r - g.m * g.m / (2.0 * g.k_abs)).abs() < 1e-12 * g.r);
         assert!((g.r - (330.0 / g.omega_c).powi(2)).abs() < 1e-12 * g.r);

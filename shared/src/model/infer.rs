@@ -1,4 +1,4 @@
-//! R inferred from a settled angle (SPEC §7).
+//! R inferred from a settled angle (physics §7).
 //!
 //! ```text
 //! from the equilibrium condition:   R = −2 sin φ0 / sin 2(φ0 − θd)
@@ -137,7 +137,7 @@ mod tests {
 
     #[test]
     fn singular_angles_use_slow_frequency() {
-        // θd = 180°, R = 3: inverted, ωp/ω0 = √(R − 1) (SPEC §3 closed form).
+        // θd = 180°, R = 3: inverted, ωp/ω0 = √(R − 1) (physics §3 closed form).
         let d = DriveAngle::from_deg(180.0).unwrap();
         assert_eq!(
             infer_r(d, math::PI, None),

@@ -1,4 +1,4 @@
-//! The pendulum model (SPEC §2–3). Its equations of motion — full, averaged, linearised, composed
+//! The pendulum model (physics §2–3). Its equations of motion — full, averaged, linearised, composed
 //! from a scene's effects — are in [`crate::sim::eom`].
 //!
 //! | module | concept |

@@ -7,7 +7,7 @@
 //! 4       2     record format version (RECORD_VERSION), little-endian
 //! 6       2     payload length n, little-endian
 //! 8       n     postcard(WireConfig): the RigConfig field for field, f64 (link::message)
-//! 8+n     4     CRC-32C over bytes 0..8+n, little-endian (the link's CRC, link::frame::CRC)
+//! 8+n     4     CRC-32C over bytes 0..8+n, little-endian (the link's CRC, crate::checksum::CRC)
 //! …             0xFF up to a multiple of 8 bytes (the STM32G4 programs 64-bit double words)
 //! ```
 //! [`load`] never fails: an erased page (all 0xFF) is [`Fallback::Missing`]; a wrong magic,
@@ -31,9 +31,9 @@
 pub mod v1;
 
 use postcard::experimental::max_size::MaxSize;
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 
-use crate::link::frame::CRC;
+use crate::checksum::CRC;
 use crate::link::reason::ConfigField;
 use crate::link::WireConfig;
 use crate::rig::config::RigConfig;
@@ -46,31 +46,7 @@ const HEAD: usize = 8;
 /// The largest record, padding included: what the firmware reserves and writes.
 pub const RECORD_MAX: usize = (HEAD + WireConfig::POSTCARD_MAX_SIZE + 4).div_ceil(8) * 8;
 
-/// Why the stored configuration was not used.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Fallback {
-    /// Nothing stored (the page is erased).
-    Missing,
-    /// Something is stored but its magic, length or checksum is wrong.
-    Corrupt,
-    /// A record of another format version (`version`).
-    Incompatible { version: u16 },
-    /// The record is intact but its configuration is out of range.
-    Invalid { field: ConfigField },
-}
-
-/// Where the configuration in use came from (reported in the status).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ConfigOrigin {
-    /// Loaded from flash at power-up.
-    Stored,
-    /// The stored one was unusable: running on the safe defaults ([`RigConfig::REFERENCE`]).
-    Defaults(Fallback),
-    /// Set over the link since power-up; `saved` says whether it reached flash.
-    Received { saved: bool },
-}
+pub use crate::link::origin::{ConfigOrigin, Fallback};
 
 /// Writes the record of `cfg` into `out`; returns its length (a multiple of 8).
 pub fn encode(cfg: &RigConfig, out: &mut [u8; RECORD_MAX]) -> usize {

@@ -47,7 +47,7 @@ pub const FAULT_AFTER: u16 = 32;
 
 /// The pendulum angle of a sensor count: `sign · (count − zero)` in 2^-14 turn, as an
 /// [`Angle`] (2^32 per turn, so · 2^18, exact). `zero` is the count with the pendulum hanging
-/// at rest, `sign` +1 if the count grows counter-clockwise seen from the front (SPEC §2).
+/// at rest, `sign` +1 if the count grows counter-clockwise seen from the front (physics §2).
 pub fn angle(count: u16, zero: u16, sign: i8) -> Angle {
     let a = Angle::from_turns_u32(u32::from(count.wrapping_sub(zero) & 0x3FFF) << 18);
     if sign < 0 {

@@ -24,7 +24,7 @@ pub struct Calibration {
     /// The pendulum sensor's count with the pendulum hanging at rest (0..2^14).
     pub pendulum_zero: u16,
     /// +1 if the pendulum sensor's count grows counter-clockwise seen from the front
-    /// (SPEC §2), −1 if clockwise.
+    /// (physics §2), −1 if clockwise.
     pub pendulum_sign: i8,
     /// +1 if the crank encoder counts up when positive duty turns the crank, −1 if its
     /// channels are swapped.

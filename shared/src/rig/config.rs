@@ -5,7 +5,7 @@
 //! code comes from [`RigConfig::derived`].
 //!
 //! ```text
-//! R = A²ω²/(2gℓ)  ⇔  ω = ωc √R,  ωc = √(2gℓ)/A        (SPEC §3; model::groups::omega_for_r)
+//! R = A²ω²/(2gℓ)  ⇔  ω = ωc √R,  ωc = √(2gℓ)/A        (physics §3; model::groups::omega_for_r)
 //! A: amplitude of the pivot's motion, half its peak-to-peak stroke (the crank radius)
 //! ```
 
@@ -16,7 +16,7 @@ use crate::error::{positive, ParamError};
 use crate::model::groups::omega_for_r;
 use crate::model::Geometry;
 
-/// Limits that no command may push the rig past (SPEC §7, "Safety").
+/// Limits that no command may push the rig past (physics §7, "Safety").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
     /// Highest drive angular frequency (rad/s).
@@ -303,7 +303,7 @@ mod tests {
 
     #[test]
     fn reference_rig_numbers() {
-        // Closed forms, SPEC §3: ℓ = 2L/3 = 0.1667 m, ωc = √(2gℓ)/A = 180.83 rad/s,
+        // Closed forms, physics §3: ℓ = 2L/3 = 0.1667 m, ωc = √(2gℓ)/A = 180.83 rad/s,
         // so R = 3 at ω = ωc√3 = 313.2 rad/s; ω0 = √(g/ℓ) = 7.672 rad/s.
         let c = RigConfig::REFERENCE.validate().unwrap();
         let w = c.omega_for_r(3.0).unwrap();

@@ -20,7 +20,6 @@
 //! | [`controller`] | one rig: the above composed into a sample tick and a control tick |
 //! | [`servo`] | θd → the tilt servo's pulse; the θd the rig starts from after a reset |
 //! | [`retained`] | the last θd and fault, kept in RAM across a reset with a CRC |
-//! | [`selftest`] | deterministic scenarios with digests, run on the host and on the emulated MCU |
 //!
 //! # Rates (why these)
 //!
@@ -45,5 +44,4 @@ pub mod fixed;
 pub mod phase_lock;
 pub mod retained;
 pub mod safety;
-pub mod selftest;
 pub mod servo;

@@ -12,7 +12,7 @@
 //! blindly: θd is range-checked again ([`super::servo::power_up_deg`]).
 
 use super::safety::Fault;
-use crate::link::frame::CRC;
+use crate::checksum::CRC;
 
 /// "KPZR", little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"KPZR");

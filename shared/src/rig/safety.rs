@@ -16,7 +16,7 @@
 //!                                        at once, duty 0, latched
 //! ```
 //! A drive strength R from the laptop becomes ω = ωc√R through [`RigConfig::omega_for_r`]
-//! before it reaches the supervisor (SPEC §7: "setting R means computing ω from R, A and ℓ").
+//! before it reaches the supervisor (physics §7: "setting R means computing ω from R, A and ℓ").
 //! Limits: ω ≤ ω_max (refused above); |dω/dt| ≤ the ramp rate (the drive generator's step, not
 //! a request); |dθd/dt| ≤ its limit (slewed here); θd inside the mount's travel (refused
 //! outside). Over-current: I > I_max for `overcurrent_ms`. Stall: commanded ω ≥ `stall_min_omega`

@@ -234,7 +234,7 @@ mod tests {
 
     #[test]
     fn full_matches_the_closed_form() {
-        // SPEC §3 written out: θ'' = −(g/ℓ) sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − c θ'.
+        // physics §3 written out: θ'' = −(g/ℓ) sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − c θ'.
         let (ell, g, a, w, c) = (0.2, 9.81, 0.01, 300.0, 0.7);
         let deg = 135.0;
         let angle = DriveAngle::from_deg(deg).unwrap();

@@ -1,4 +1,4 @@
-//! Which equation a scene runs, and why (SPEC §5).
+//! Which equation a scene runs, and why (physics §5).
 //!
 //! ```text
 //! averaged    valid when ω/ω0 ≥ 10 and A/ℓ ≤ 0.1, no Coulomb friction (its average needs its own
@@ -49,7 +49,7 @@ impl fmt::Display for Why {
             Why::AmplitudeTooLarge { a_over_l } => {
                 write!(f, "averaged invalid: A/l = {a_over_l:.3} > {AVERAGED_MAX_A_OVER_L}")
             }
-            Why::Coulomb => f.write_str("averaged and linearised models do not describe Coulomb friction (SPEC §5)"),
+            Why::Coulomb => f.write_str("averaged and linearised models do not describe Coulomb friction (physics §5)"),
             Why::StartsFromRest => {
                 f.write_str("averaged invalid: ramp/actuator start the drive from rest, where ω/ω0 is small")
             }

@@ -19,7 +19,7 @@
 //! The first probe with g ≤ 0 ends the search, and the reversal is bisected between it and the
 //! probe before it. Under a strong drive θ'
 //! (which includes the fast wobble) changes sign twice a period and friction acts like weak
-//! damping; sticking needs φ near θd or a weak drive (SPEC §5).
+//! damping; sticking needs φ near θd or a weak drive (physics §5).
 
 use super::eom::{FullEom, NoExtra, Sliding};
 use super::run::{Context, Dense, Method, RunOut, SimError};

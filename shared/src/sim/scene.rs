@@ -22,7 +22,7 @@ pub struct DriveSpec {
     pub angle: DriveAngle,
 }
 
-/// Viscous damping, as a quality factor Q = ω0/c or as γ = c/2 (SPEC §3).
+/// Viscous damping, as a quality factor Q = ω0/c or as γ = c/2 (physics §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Viscous {
     Q(f64),
@@ -355,7 +355,7 @@ impl Scene {
         let a = self.drive.amplitude;
         let omega = match self.drive.frequency {
             DriveFrequency::Omega(w) => w,
-            // R = A²ω²/(2 g ℓ) with the effective gravity (SPEC §5: under tilt R uses g cos β).
+            // R = A²ω²/(2 g ℓ) with the effective gravity (physics §5: under tilt R uses g cos β).
             DriveFrequency::R(r) => crate::math::sqrt(2.0 * g_eff * ell * r) / a,
         };
         let c = match self.effects.viscous {

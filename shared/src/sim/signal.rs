@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! pivot displacement along u = (sin θd, −cos θd):  s(t) = a1 cos ϕ + a2 cos 2ϕ
-//!   a1 = A,  a2 = A²/(4b) with a slider-crank of rod length b (else 0)      (SPEC §5)
+//!   a1 = A,  a2 = A²/(4b) with a slider-crank of rod length b (else 0)      (physics §5)
 //! phase ϕ(t) = ∫ω dt, so   s̈ = −a1 (ω² cos ϕ + ω̇ sin ϕ) − a2 (4ω² cos 2ϕ + 2ω̇ sin 2ϕ)
 //! ```
 //! A steady sinusoid ([`Steady`]) is the common case and has its own type, so that a scene

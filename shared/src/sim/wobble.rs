@@ -12,7 +12,7 @@
 //! full:    θ'' = −ω0² sin θ + (s̈/ℓ) sin(θ − θd) − c θ'
 //!          s/ℓ = w(ψ) = a1 cos ψ + a2 cos 2ψ,   s̈/ℓ = −ω² (a1 cos ψ + 4 a2 cos 2ψ),   ψ = ωt + ψ0
 //! ```
-//! (a1 = A/ℓ; a2 = A²/(4bℓ) with a slider-crank of rod length b, else 0; SPEC §3, §5.) Scales:
+//! (a1 = A/ℓ; a2 = A²/(4bℓ) with a slider-crank of rod length b, else 0; physics §3, §5.) Scales:
 //! ε = ω0/ω is small and R = a1²ω²/(2ω0²) is of order one, so a1, a2 = O(ε), φ' = O(εω),
 //! φ'' = O(ε²ω²), δ = c/ω = O(ε/Q). Write θ = φ + ξ with φ slow and ξ fast (zero mean over a
 //! drive period), S = sin(φ − θd), C = cos(φ − θd), and collect the fast terms order by order

@@ -2,14 +2,14 @@
 //! motor that turns the crank. State `[θ, θ', ψ, ψ']`.
 //!
 //! ```text
-//! pivot along the drive line:  s(ψ) = A cos ψ + (A²/4b) cos 2ψ        (slider-crank, rod b; SPEC §5)
+//! pivot along the drive line:  s(ψ) = A cos ψ + (A²/4b) cos 2ψ        (slider-crank, rod b; physics §5)
 //!                              s'' = s_ψψ ψ'² + s_ψ ψ''
 //!                              s_ψ = −A sin ψ − (A²/2b) sin 2ψ,  s_ψψ = −A cos ψ − (A²/b) cos 2ψ
 //! pendulum (pivot frame):      θ'' = −ω0² sin θ + (s''/ℓ) sin(θ − θd) − c θ' − friction
 //! motor (first-order speed lag behind the bridge duty u, its true gain, not the configured one):
 //!                              ψ'' = (±K u − ψ')/τ,   I = (V u − kₑ ψ')/Rₐ
 //! ```
-//! With ψ = ωt and no connecting rod, s'' = −Aω² cos ωt and the pendulum equation is SPEC §3's
+//! With ψ = ωt and no connecting rod, s'' = −Aω² cos ωt and the pendulum equation is physics §3's
 //! full equation exactly (tested). The pivot follows the motor, not the reference, so the phase
 //! lock's errors reach the pendulum as they would on the bench.
 //!
@@ -154,7 +154,7 @@ mod tests {
     #[test]
     fn at_constant_crank_speed_it_is_the_full_equation() {
         // Also the closed-loop tests' plant (tests/tests/closed_loop_sim).
-        // SPEC §3: θ'' = −ω0² sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − cθ' when ψ = ωt, ψ' = ω,
+        // physics §3: θ'' = −ω0² sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − cθ' when ψ = ωt, ψ' = ω,
         // ψ'' = 0 (the motor at its steady speed: duty = ω/K). Closed form, to rounding.
         let mut p = plant();
         let w = 188.0;

@@ -1,7 +1,7 @@
 //! Level 1: averaging (Kapitza; Landau & Lifshitz, *Mechanics*, §30).
 //!
 //! Splitting the motion into a slow part and a fast wobble at the drive frequency and averaging
-//! over the wobble gives an effective potential (SPEC §3). About the inverted position
+//! over the wobble gives an effective potential (physics §3). About the inverted position
 //! (θd = 180°, vertical drive) its curvature is ω0²(R − 1), so
 //!
 //! ```text
@@ -52,9 +52,9 @@ mod tests {
 
     #[test]
     fn spec_table_values() {
-        // SPEC §4 table, k = −0.3: √(−2k) = √0.6 = 0.7746, printed 0.775 (3 decimals).
+        // physics §4.5, k = −0.3: √(−2k) = √0.6 = 0.7746, printed 0.775 (3 decimals).
         assert!((lower(-0.3).unwrap() - 0.775).abs() < 5e-4);
-        // SPEC §4 table, Landau row: g = 9.81, l = 1 m, ω = 9 rad/s: k = −g/(lω²), and the
+        // physics §4.5, Landau row: g = 9.81, l = 1 m, ω = 9 rad/s: k = −g/(lω²), and the
         // bound on the amplitude a = m·l is √(2g/(lω²)) = 0.4922, printed 0.492.
         let k = -9.81 / (1.0 * 81.0);
         assert!((lower(k).unwrap() - 0.492).abs() < 5e-4);

@@ -1,4 +1,4 @@
-//! Level 4: Floquet theory — the reference the other levels are judged against (SPEC §4).
+//! Level 4: Floquet theory — the reference the other levels are judged against (physics §4).
 //!
 //! The linearised equation has 2π-periodic coefficients, so one period's solution map, the
 //! *monodromy matrix* M, decides stability (Floquet; e.g. Magnus & Winkler, *Hill's Equation*,
@@ -51,7 +51,7 @@ use crate::math;
 
 /// Default RK4 steps per drive period (see the module doc for the measurement behind it).
 pub const DEFAULT_STEPS: u32 = 1000;
-/// Default scan step in m: well under the narrowest window in the SPEC (k = −0.5: ≈ 0.03 wide).
+/// Default scan step in m: well under the narrowest window of the reference table (physics §4.5) (k = −0.5: ≈ 0.03 wide).
 pub const DEFAULT_SCAN_STEP: f64 = 0.002;
 /// Default scan limit in m.
 pub const DEFAULT_SCAN_LIMIT: f64 = 10.0;

@@ -45,7 +45,7 @@
 //!   For n = 2 the set collapses to {1, 3, 5} and the threshold is the flutter boundary.
 //! ```
 //!
-//! Butikov's printed systems contain sign misprints (SPEC §4); the ones above are derived here,
+//! Butikov's printed systems contain sign misprints (physics §4); the ones above are derived here,
 //! and the unit tests check each one independently of the algebra: the series built from a
 //! null vector of the matrix at the root balances every retained harmonic of the equation.
 //!

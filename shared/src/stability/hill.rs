@@ -1,7 +1,7 @@
 //! Level 4 without integration: Hill's method for the undamped linear equation, and damping
 //! mapped onto it exactly.
 //!
-//! With z = τ/2 the undamped equation is Mathieu's (SPEC §4), and a solution with characteristic
+//! With z = τ/2 the undamped equation is Mathieu's (physics §4), and a solution with characteristic
 //! exponent ν is y = e^{iνz} Σ_r c_r e^{2irz}. Putting that in gives one row per harmonic r
 //! (Hill's three-term recurrence; McLachlan, *Theory and Application of Mathieu Functions*,
 //! §2.13–2.15; Abramowitz & Stegun 20.2–20.3):
@@ -100,7 +100,7 @@ pub fn stability_count(a: f64, q: f64) -> u32 {
 ///
 /// ```
 /// use kapitza_core::stability::hill;
-/// // Inverted, k = −0.3: stable between m = 0.868 and 0.929 (SPEC §4; docs/stability.md).
+/// // Inverted, k = −0.3: stable between m = 0.868 and 0.929 (physics §4; docs/stability.md).
 /// assert!(!hill::is_stable(-0.3, 0.85).unwrap());
 /// assert!(hill::is_stable(-0.3, 0.90).unwrap());
 /// assert!(!hill::is_stable(-0.3, 0.95).unwrap());

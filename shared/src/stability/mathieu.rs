@@ -1,6 +1,6 @@
 //! Level 2: the small-q series of Mathieu's characteristic values.
 //!
-//! With z = τ/2 the undamped linearised equation is Mathieu's (SPEC §4):
+//! With z = τ/2 the undamped linearised equation is Mathieu's (physics §4):
 //!
 //! ```text
 //! y'' + (a − 2q cos 2z) y = 0,   a = 4k,  q = 2m

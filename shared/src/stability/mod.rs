@@ -1,8 +1,8 @@
-//! Stability theory of the vertically driven pendulum (SPEC §4): four levels, each cheaper one
+//! Stability theory of the vertically driven pendulum (physics §4): four levels, each cheaper one
 //! less accurate.
 //!
 //! All four study the equation linearised about the hanging or the inverted position, in
-//! dimensionless time τ = ωt (SPEC §3):
+//! dimensionless time τ = ωt (physics §3):
 //!
 //! ```text
 //! x'' + δ x' + (k − m cos τ) x = 0

@@ -35,18 +35,20 @@
 //! [`crate::rig::calibration::Calibration`], so a calibration set over the link is in use from
 //! the next sample, on the firmware and the simulated rig alike.
 //!
+//! **Every request is answered by [`serve::RigServer`]**: commands all or nothing, status and
+//! telemetry built from the rig's state.
+//!
 //! **A start from idle waits for its pre-run check** ([`precheck`]): the status shows it
 //! running, then its verdict; the drive starts only on a pass. **Bring-up mode** drives the
 //! crank open loop at a capped duty and streams the sensors raw ([`Response::Raw`]).
 
 pub mod drive;
 pub mod precheck;
-pub mod selftest;
+pub mod serve;
 
 use crate::link::convert::to_q16;
 use crate::link::frame::{decode_request_as, encode, open, Header};
 use crate::link::message::{Check, Counters, RawTelemetry, ResetInfo, Verdict};
-use crate::link::serve::{apply, Activity, Clock, Effect, RigServer};
 use crate::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 use crate::persist::ConfigOrigin;
 use crate::rig::as5047::Diagnostics;
@@ -58,6 +60,7 @@ use crate::rig::phase_lock::Motor;
 use crate::rig::safety::Mode;
 use drive::{Calibrated, Drive};
 use precheck::{SensorView, Step};
+use serve::{apply, Activity, Clock, Effect, RigServer};
 
 /// The shortest telemetry period (ms): a telemetry frame is ≤ 100 bytes, 8.7 ms at 115200 baud.
 pub const MIN_TELEMETRY_MS: u16 = 20;

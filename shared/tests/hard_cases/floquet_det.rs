@@ -40,7 +40,7 @@ fn hc08_det_is_liouville() {
 
 #[test]
 fn hc08_det_over_many_periods() {
-    // SPEC §6: det M against e^{−cT} over long periods. det(M^N) = det(M)^N = e^{−2πNδ}
+    // physics §6: det M against e^{−cT} over long periods. det(M^N) = det(M)^N = e^{−2πNδ}
     // (closed form); the per-period relative error (4.1e-12 here, measured) accumulates
     // linearly: tolerance N · 1e-11 for N = 1000 periods (multiplied out as 2×2 products).
     let (k, delta, m) = (-0.3, 0.02, 0.9);

@@ -33,7 +33,7 @@ fn hc05_large_r_short_rod_settles_where_theory_says() {
     let scene = violent(135.0, 100.0);
     let p = scene.physical().unwrap();
     assert!((p.r - 254.8).abs() < 0.1, "R = {}", p.r);
-    // Averaged theory (SPEC §3): the stable equilibrium within 90° of θd. Its error is
+    // Averaged theory (physics §3): the stable equilibrium within 90° of θd. Its error is
     // O((A/ℓ)²) = 2.5e-3 rad here; tolerance 0.3°.
     let theory = equilibria(p.r, scene.drive.angle)
         .unwrap()
@@ -82,7 +82,7 @@ fn hc05_large_r_short_rod_settles_where_theory_says() {
 #[test]
 fn hc05_large_r_holds_the_inverted_position() {
     // Vertical drive, R = 255 ≫ 1 and m = A/ℓ = 0.05 inside the Floquet window: the inverted
-    // position is stable (SPEC §3-4); from 170° the pendulum must rise to 180°.
+    // position is stable (physics §3-4); from 170° the pendulum must rise to 180°.
     let scene = violent(180.0, 170.0);
     let report = simulate(&scene, &Options::default(), &mut Discard).unwrap();
     let got = rest_deg(report.outcome);

@@ -1,4 +1,4 @@
-//! The hard-case suite (SPEC §6, docs/hard-cases.md): each case states what could go wrong, the
+//! The hard-case suite (physics §6, docs/hard-cases.md): each case states what could go wrong, the
 //! guard the code uses against it and a criterion that catches the failure. Test names carry the
 //! case's id (`hcNN_…`), the same as in the document.
 //!

@@ -1,4 +1,4 @@
-//! HC06: equilibria where they merge — on and next to the saddle-node curve R_sn(θd) (SPEC §3),
+//! HC06: equilibria where they merge — on and next to the saddle-node curve R_sn(θd) (physics §3),
 //! at the cusps R = 1, θd = 0°/90°/180° where three roots meet, and at and next to the special
 //! drive angles. The finder isolates the roots of a trigonometric polynomial by derivative
 //! recursion (no sampling) and merges roots closer than `MERGE_RAD`; the risk is an equilibrium
@@ -14,7 +14,7 @@ fn drive(deg: f64) -> DriveAngle {
 
 #[test]
 fn hc06_marginal_at_r2_theta135() {
-    // SPEC §4 table: at R = 2, θd = 135° the reachable equilibrium is marginal (on R_sn).
+    // physics §4.5: at R = 2, θd = 135° the reachable equilibrium is marginal (on R_sn).
     let eqs = equilibria(2.0, drive(135.0)).unwrap();
     let reach: Vec<_> = eqs.as_slice().filter(|e| e.within_90_of_drive).collect();
     assert!(
@@ -61,7 +61,7 @@ fn hc06_special_angles_and_neighbours_keep_their_equilibria() {
 
 #[test]
 fn hc06_three_roots_meet_at_the_cusps() {
-    // R = 1 at θd = 0°, 90°, 180° (SPEC §3: three roots meet): one marginal equilibrium where
+    // R = 1 at θd = 0°, 90°, 180° (physics §3: three roots meet): one marginal equilibrium where
     // they meet, and one other equilibrium — two in all, none duplicated.
     for (deg, meet) in [(0.0, math::PI), (90.0, 0.0), (180.0, math::PI)] {
         let eqs = equilibria(1.0, drive(deg)).unwrap();
@@ -78,7 +78,7 @@ fn hc06_three_roots_meet_at_the_cusps() {
         assert_eq!(m.stability, Stability::Marginal, "θd {deg}");
     }
     // Just above the cusp the three separate: at θd = 180°, R = 1 + 1e-6 the inverted position
-    // is stable and two unstable equilibria flank it at cos φ = −1/R (closed form, SPEC §3).
+    // is stable and two unstable equilibria flank it at cos φ = −1/R (closed form, physics §3).
     let eqs = equilibria(1.0 + 1e-6, drive(180.0)).unwrap();
     assert_eq!(eqs.len(), 4);
     let inv = eqs

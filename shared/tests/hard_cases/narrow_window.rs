@@ -1,4 +1,4 @@
-//! HC04: the narrow stability window at k = −0.5 (SPEC §4): the inverted pendulum is stable
+//! HC04: the narrow stability window at k = −0.5 (physics §4): the inverted pendulum is stable
 //! only for m between the lower and the upper boundary, 0.0308 apart. The risk: a scan steps
 //! over the window, or the verdict next to a boundary depends on the step count.
 
@@ -11,7 +11,7 @@ fn value(e: End) -> f64 {
 
 #[test]
 fn hc04_verdict_does_not_flip_a_hair_from_the_narrow_window() {
-    // SPEC §6 hard case. k = −0.5: the window is 0.0308 wide. 1e-7 inside each end the verdict
+    // physics §6 hard case. k = −0.5: the window is 0.0308 wide. 1e-7 inside each end the verdict
     // is "stable", 1e-7 outside "unstable", at every converged step count (boundary error
     // ≤ 1.2e-11 ≪ 1e-7).
     let w = floquet::window(-0.5, 0.0, 1e-12).unwrap().value;

@@ -1,4 +1,4 @@
-//! HC07: R inferred from a settled angle where the formula is singular (SPEC §7).
+//! HC07: R inferred from a settled angle where the formula is singular (physics §7).
 //!
 //! R = −2 sin φ0 / sin 2(φ0 − θd) is 0/0 at θd = 0° and 180°, where the equilibria sit at
 //! φ0 = 0 or π, and ill-conditioned next to them. `model::infer` switches to the slow-frequency
@@ -9,7 +9,7 @@ use kapitza_core::math;
 use kapitza_core::model::{equilibria, infer_r, DriveAngle, RMethod};
 
 /// (ωp/ω0)² = v''(φ0) = cos φ0 + R cos 2(φ0 − θd): the averaged theory's slow frequency (closed
-/// form, SPEC §3).
+/// form, physics §3).
 fn slow_frequency_sq(r: f64, d: DriveAngle, phi0: f64) -> f64 {
     math::cos(phi0) + r * math::cos(2.0 * (phi0 - d.rad()))
 }

@@ -1,4 +1,4 @@
-//! HC03: Coulomb friction at stick–slip (SPEC §5).
+//! HC03: Coulomb friction at stick–slip (physics §5).
 //!
 //! Friction torque per unit inertia μ opposes sliding; at θ' = 0 the pendulum sticks if static
 //! friction can hold it, |a(t, θ)| ≤ μ with a = −ω0² sin θ + (s̈/ℓ) sin(θ − θd). Integrating the
@@ -169,7 +169,7 @@ fn hc03_strong_drive_never_sticks_spuriously() {
     // μ = 2 rad/s² besides:
     // θ' changes sign twice a period, but there |a| ≈ (Aω²/ℓ)|sin(φ − θd)| ≈ 2000 rad/s² ≫ μ, so
     // the pendulum must slide through every reversal and settle at the averaged theory's
-    // 118.98° (SPEC §3), friction acting like weak damping.
+    // 118.98° (physics §3), friction acting like weak damping.
     let mut scene = scene(Geometry::rod(0.20).unwrap(), 0.0089, 330.0, 135.0);
     scene.initial_angle = math::to_rad(100.0);
     scene.length = RunLength::Periods(3000.0);

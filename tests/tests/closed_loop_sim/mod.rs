@@ -136,7 +136,7 @@ impl Sim {
         }
         if let Some(th) = self.hold {
             // The hand holds the slow angle and lets the fast wobble happen (first-order wobble
-            // ξ = (A/ℓ) sin(φ − θd) cos ψ, SPEC §3), so letting go does not kick the pendulum.
+            // ξ = (A/ℓ) sin(φ − θd) cos ψ, physics §3), so letting go does not kick the pendulum.
             let k = self.plant.amplitude / self.plant.ell * math::sin(th - self.plant.theta_d);
             let (sp, cp) = math::sin_cos(self.y[2]);
             self.y[0] = th + k * cp;

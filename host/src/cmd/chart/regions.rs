@@ -71,7 +71,7 @@ pub fn reachable_stable(r: f64, theta_deg: f64) -> Result<bool> {
 }
 
 /// The band at R by scanning θd ∈ [0°, 180°] in 0.25° steps and bisecting each end to 1e-10°.
-/// None outside 1 < R < 2, where every θd has a reachable stable equilibrium (R ≥ 2, SPEC §4)
+/// None outside 1 < R < 2, where every θd has a reachable stable equilibrium (R ≥ 2, physics §4)
 /// or the unreachable set runs up to 180° (R ≤ 1) and is not a band.
 pub fn band(r: f64) -> Result<Band> {
     let none = Band {

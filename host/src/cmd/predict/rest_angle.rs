@@ -1,7 +1,7 @@
 //! `kapitza predict --rest-angle DEG`: which drive angles put a stable, reachable equilibrium
 //! at a wanted angle φ0, and for which R.
 //!
-//! The equilibrium condition solved for the drive angle (SPEC §3), with x = φ0 − θd:
+//! The equilibrium condition solved for the drive angle (physics §3), with x = φ0 − θd:
 //!
 //! ```text
 //! sin φ0 + (R/2) sin 2x = 0      ⇒  sin 2x = −2 sin φ0 / R      (|·| ≤ 1: R ≥ 2|sin φ0|)

@@ -6,7 +6,7 @@
 //! I_k  = (2/N_k) Σ (u_i − u_start) cos ψ_i,   Q_k = (2/N_k) Σ (u_i − u_start) sin ψ_i
 //! ```
 //! A period ends where the drive phase ψ wraps through zero. Averaging over whole periods of the
-//! drive removes the fast wobble ξ ≈ (A/ℓ) sin(φ − θd) cos ψ (SPEC §3) and all its harmonics, up
+//! drive removes the fast wobble ξ ≈ (A/ℓ) sin(φ − θd) cos ψ (physics §3) and all its harmonics, up
 //! to the fraction of a sample by which N_k misses a whole period (a residual ≲ |ξ|/N_k). I and
 //! Q demodulate the wobble itself. Because the sums run on the unwrapped u, a pendulum that
 //! rotates (unbounded angle) still averages correctly, as long as it turns less than half a turn

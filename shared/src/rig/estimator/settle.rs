@@ -5,7 +5,7 @@
 //! fast wobble's I/Q are averaged over the same block.
 //!
 //! ```text
-//! R in situ (SPEC §7, model::infer):
+//! R in situ (physics §7, model::infer):
 //!   |sin 2(φ0 − θd)| ≥ 0.05:  R = −2 sin φ0 / sin 2(φ0 − θd)                (equilibrium condition)
 //!   otherwise, with ωp:       R = ((ωp/ω0)² − cos φ0) / cos 2(φ0 − θd)     (slow frequency)
 //!   (θd = 0° and 180° put φ0 at 0 or π, exactly where the first is 0/0.)
@@ -203,7 +203,7 @@ mod tests {
                 );
             }
         }
-        // Singular: θd = 180°, φ0 = π, ωp² = ω0²(R − 1) with R = 3 (SPEC §3 closed form).
+        // Singular: θd = 180°, φ0 = π, ωp² = ω0²(R − 1) with R = 3 (physics §3 closed form).
         let w02 = RadPerSec::from_num(58.86);
         let wp2 = RadPerSec::from_num(58.86 * 2.0);
         assert_eq!(

@@ -17,7 +17,7 @@
 //! ```
 //! The window slides, so large first swings (whose frequency is shifted by the nonlinearity of
 //! the effective potential) give way to small ones, and the estimate freezes on the last window
-//! of usable swings once the motion has decayed: that is the small-oscillation ωp of SPEC §3.
+//! of usable swings once the motion has decayed: that is the small-oscillation ωp of physics §3.
 //! Only swings ≥ `min_swing` count (smaller ones are noise-timed); the motion's first extremum —
 //! the release from the hand, or a drive transient — is never declared, because the direction is
 //! not known until the signal has moved by h. Times are 32-bit µs stamps; only their wrapping

@@ -151,7 +151,7 @@ fn truncated_formula_is_the_two_by_two_root() {
         let r = (4.0 * k - 1.0 - 2.0 * m) * (4.0 * k - 9.0) - 4.0 * m * m;
         assert!(r.abs() < 1e-12, "{k}: {r:e}");
     }
-    // k = 0: closed form 3(√13 − 3)/4 (SPEC §4).
+    // k = 0: closed form 3(√13 − 3)/4 (physics §4).
     let want = 3.0 * (math::sqrt(13.0) - 3.0) / 4.0;
     assert!((truncated_upper(0.0).unwrap().value().unwrap() - want).abs() < 1e-15);
     assert_eq!(truncated_upper(1.0).unwrap(), End::Missing(NO_REAL_ROOT));

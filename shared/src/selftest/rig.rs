@@ -8,12 +8,12 @@
 //! output. To regenerate the expected digests after a deliberate change:
 //! `cargo test -p kapitza-core --test rig_selftest -- --nocapture` prints them.
 
-use super::config::RigConfig;
-use super::dds::{word_from_omega, Dds};
-use super::estimator::{Estimate, Estimator, Tuning};
-use super::fixed::{approx, trig, Angle, RadPerSec};
-use super::phase_lock::PhaseLock;
-use super::safety::{Inputs, Mode, Request, Supervisor};
+use crate::rig::config::RigConfig;
+use crate::rig::dds::{word_from_omega, Dds};
+use crate::rig::estimator::{Estimate, Estimator, Tuning};
+use crate::rig::fixed::{approx, trig, Angle, RadPerSec};
+use crate::rig::phase_lock::PhaseLock;
+use crate::rig::safety::{Inputs, Mode, Request, Supervisor};
 
 /// FNV-1a, 64-bit (Fowler–Noll–Vo; offset basis and prime from the published parameters).
 #[derive(Debug, Clone, Copy)]
@@ -254,14 +254,14 @@ struct IntMotor {
     duty: i64,
 }
 
-impl super::phase_lock::Motor for IntMotor {
+impl crate::rig::phase_lock::Motor for IntMotor {
     fn crank_angle(&mut self) -> Angle {
         self.crank
     }
-    fn current(&mut self) -> super::fixed::Amps {
-        super::fixed::Amps::from_bits((self.duty * 6) as i32) // 12 V/2 Ω at full duty, no EMF
+    fn current(&mut self) -> crate::rig::fixed::Amps {
+        crate::rig::fixed::Amps::from_bits((self.duty * 6) as i32) // 12 V/2 Ω at full duty, no EMF
     }
-    fn set_duty(&mut self, d: super::fixed::Duty) {
+    fn set_duty(&mut self, d: crate::rig::fixed::Duty) {
         self.duty = i64::from(d.to_bits());
     }
 }
@@ -279,7 +279,8 @@ impl IntMotor {
 /// ramped change, a refused request, a tilt, an e-stop and a restart, with a synthetic pendulum.
 fn rig_controller() -> u64 {
     let cfg = RigConfig::REFERENCE;
-    let mut rig = super::controller::Rig::new(&cfg, &Tuning::DEFAULT, Angle::from_deg(135.0), 0);
+    let mut rig =
+        crate::rig::controller::Rig::new(&cfg, &Tuning::DEFAULT, Angle::from_deg(135.0), 0);
     let mut m = IntMotor {
         crank: Angle::from_deg(40.0),
         speed_q16: 0,
@@ -324,8 +325,8 @@ fn rig_controller() -> u64 {
 /// cut cable, magnet loss), the e-stop debounce on a noisy line, the sample clock's skip rule,
 /// and the supervisor's wrong-direction and sensor faults.
 fn bench_faults() -> u64 {
-    use super::as5047::As5047;
-    use super::estop::EStop;
+    use crate::rig::as5047::As5047;
+    use crate::rig::estop::EStop;
     use crate::simrig::sensor::{Chip, Line, DIAAGC_NO_MAGNET, DIAAGC_OK};
     let mut d = Digest::default();
     let mut chip = Chip::default();

@@ -2,17 +2,17 @@
 //! run by the host tests (`shared/tests/rig_selftest.rs`) and on the emulated Cortex-M4F
 //! (`qemu/`) against the same expected digest, so the firmware's loop computes the same bits on
 //! the target as the simulated rig does on the laptop. The digest and its regeneration are
-//! [`crate::rig::selftest`]'s.
+//! [`super::rig`]'s.
 
-use super::drive::Drive;
-use super::{RigLoop, Sample};
+use super::rig::{Case, Digest};
 use crate::link::frame::{encode, Header};
 use crate::link::{Request, MAX_REQUEST_FRAME};
 use crate::persist::ConfigOrigin;
 use crate::rig::as5047::Diagnostics;
 use crate::rig::config::RigConfig;
 use crate::rig::fixed::{Angle, Duty};
-use crate::rig::selftest::{Case, Digest};
+use crate::station::drive::Drive;
+use crate::station::{RigLoop, Sample};
 
 /// A crank that follows the duty with a first-order lag, in integers (0.9 · 500 rad/s at full
 /// duty, τ = 60 ms, 1 ms steps), and a current sense reading 6/77 of the duty in counts.

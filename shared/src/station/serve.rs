@@ -2,19 +2,19 @@
 //! building the status and telemetry messages from it, and [`RigServer`], which answers every
 //! request. [`crate::station::RigLoop`] owns one and frames its answers.
 
-use super::convert::{deg_along_travel, from_q16, to_q16};
-use super::message::Verdict;
-use super::message::{
+use super::precheck::PreCheck;
+use crate::link::convert::{deg_along_travel, from_q16, to_q16};
+use crate::link::message::Verdict;
+use crate::link::message::{
     Check, Counters, Mode, Request, ResetInfo, Response, Status, Telemetry, VersionInfo, WireConfig,
 };
-use super::reason::Reason;
+use crate::link::reason::Reason;
 use crate::persist::ConfigOrigin;
 use crate::rig::config::RigConfig;
 use crate::rig::controller::{ControlReport, Rig};
 use crate::rig::dds::omega_of_word;
 use crate::rig::fixed::{Amps, Angle, Duty};
 use crate::rig::safety::{self, Request as Sr};
-use crate::station::precheck::PreCheck;
 
 /// A request that changes the drive. Everything else ([`Request::GetVersion`],
 /// [`Request::GetStatus`], …) is answered without touching the rig.
@@ -195,7 +195,7 @@ pub struct RigServer {
     pub heard_us: u32,
     /// This firmware's version, reported by `GetVersion`.
     pub firmware: [u16; 3],
-    /// The protocol version reported by `GetVersion`: [`super::PROTOCOL_VERSION`] unless a
+    /// The protocol version reported by `GetVersion`: [`crate::link::PROTOCOL_VERSION`] unless a
     /// simulated rig is made to speak another one.
     pub protocol: u8,
     /// Why the rig last reset (reported in the status).
@@ -222,7 +222,7 @@ impl RigServer {
             check: None,
             heard_us: at.link_us,
             firmware,
-            protocol: super::PROTOCOL_VERSION,
+            protocol: crate::link::PROTOCOL_VERSION,
             reset: ResetInfo::POWER_ON,
         }
     }

@@ -1,0 +1,34 @@
+//! Where the rig's configuration in use came from, and why a stored one was not used: reported
+//! in the status, so it is a wire type (pinned by the golden frames); the flash record
+//! ([`crate::persist`]) decides it.
+
+use postcard::experimental::max_size::MaxSize;
+use serde::{Deserialize, Serialize};
+
+use super::reason::ConfigField;
+
+/// Why the stored configuration was not used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Fallback {
+    /// Nothing stored (the page is erased).
+    Missing,
+    /// Something is stored but its magic, length or checksum is wrong.
+    Corrupt,
+    /// A record of another format version (`version`).
+    Incompatible { version: u16 },
+    /// The record is intact but its configuration is out of range.
+    Invalid { field: ConfigField },
+}
+
+/// Where the configuration in use came from (reported in the status).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigOrigin {
+    /// Loaded from flash at power-up.
+    Stored,
+    /// The stored one was unusable: running on the safe defaults ([`crate::rig::config::RigConfig::REFERENCE`]).
+    Defaults(Fallback),
+    /// Set over the link since power-up; `saved` says whether it reached flash.
+    Received { saved: bool },
+}
