@@ -18,6 +18,7 @@
 //! | [`persist`] | the rig configuration as a checksummed flash record, with the fallback to safe defaults |
 //! | [`station`] | the rig loop: one rig and its link end, hardware-free (samples, control ticks, bytes in → frames out), run by the firmware, the on-target tests and the simulated rig |
 //! | [`simrig`] | the simulated rig: the pendulum's full equation on the crank's actual angle, motor, sensors, servo and e-stop, around a [`station::RigLoop`] |
+//! | [`calib`] | calibration from what the rig reports: sensor zero and direction, crank direction, servo map, current offset, ℓ and damping from a ring-down, the stroke from the wobble |
 //! | [`cases`] | canonical cases with known answers, shared by tests, benchmarks and scenes |
 //!
 //! # Conventions (SPEC §2–3)
@@ -34,6 +35,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod calib;
 pub mod cases;
 pub mod error;
 pub mod integrate;
