@@ -12,6 +12,7 @@
 //! | [`decay`] | the envelope's decay: viscous (geometric), Coulomb (linear) or both, and which |
 //! | [`ringdown`] | system identification from a ring-down with the drive off: zero, ω0, ℓ, Q, μ |
 //! | [`stroke`] | the stroke A from the fast wobble's amplitude, hanging at θd = 90° |
+//! | [`plumb`] | the mount's true drive angle from the hanging pendulum's lean |
 //! | [`direction`] | the sensor's direction from a counter-clockwise nudge; the crank's from a pulse |
 //! | [`servo_fit`] | the servo's pulse → angle line from jog-to-mark pairs, and its travel |
 //! | [`current`] | the current sensor's offset at rest |
@@ -26,6 +27,7 @@ pub mod decay;
 pub mod direction;
 pub mod error;
 pub mod period;
+pub mod plumb;
 pub mod ringdown;
 pub mod servo_fit;
 pub mod stroke;

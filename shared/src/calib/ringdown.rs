@@ -158,6 +158,35 @@ pub fn identify(t: &[f64], theta: &[f64], g: f64, lim: &Limits) -> Result<RingDo
     })
 }
 
+/// Where a record of a held-and-released pendulum starts swinging freely: the last sample of
+/// the hold, found as the sample farthest from where the record ends (at rest), followed
+/// forward while the reading stays within `hysteresis` of it. A record that starts before the
+/// pendulum was lifted has a lift in it that is no free swing; [`identify`] wants the record
+/// from here on.
+pub fn release_index(theta: &[f64], hysteresis: f64) -> usize {
+    let Some(&end) = theta.last() else {
+        return 0;
+    };
+    let far = theta
+        .iter()
+        .enumerate()
+        .fold((0, 0.0), |(k, d), (i, x)| {
+            let di = (x - end).abs();
+            if di > d {
+                (i, di)
+            } else {
+                (k, d)
+            }
+        })
+        .0;
+    let held = theta[far];
+    let mut k = far;
+    while k + 1 < theta.len() && (theta[k + 1] - held).abs() < hysteresis {
+        k += 1;
+    }
+    k
+}
+
 /// The swing's centre from the turning points (module doc).
 fn centre(turns: &[Turn]) -> f64 {
     let interior = turns.len().saturating_sub(2);

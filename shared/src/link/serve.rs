@@ -56,6 +56,7 @@ pub fn apply(rig: &mut Rig, cfg: &RigConfig, cmd: Command) -> Result<(), Reason>
             trial.request(Sr::SetDriveAngle {
                 deg: from_q16(theta_d_deg),
             })?;
+            trial.r_asked(from_q16(r));
             if r == 0 {
                 trial.request(Sr::Stop)?;
             } else {

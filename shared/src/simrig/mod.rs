@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`plant`] | the pendulum driven by the crank's actual angle, the DC motor, friction |
 //! | [`sensor`] | the pendulum sensor's chip behind its SPI pins (AS5047P), with its faults |
+//! | [`hand`] | a lab hand that lifts and lets go of the pendulum when calibration asks for it |
 //!
 //! ```text
 //! every sample period h = 1/fs:
@@ -20,6 +21,7 @@
 //! and motor direction, servo offset, current offset) are those calibration must find.
 //! Everything is deterministic under [`Params::seed`].
 
+pub mod hand;
 pub mod plant;
 pub mod sensor;
 
