@@ -92,7 +92,7 @@ impl RTrim {
         let s = self.settings;
         let since = *self.since_us.get_or_insert(now_us);
         let measured = settled_r?;
-        if !s.enabled || self.asked <= 0.0 || !(measured > 0.0) {
+        if !s.enabled || self.asked <= 0.0 || measured.is_nan() || measured <= 0.0 {
             return None;
         }
         if (measured - self.asked).abs() <= s.band {
