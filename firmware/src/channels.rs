@@ -23,9 +23,10 @@ pub static FROM_LAPTOP: Pipe<Cs, 256> = Pipe::new();
 pub static LINE_ERROR: Signal<Cs, ()> = Signal::new();
 /// control → link: frame bytes for the laptop (answers and telemetry).
 pub static TO_LAPTOP: Pipe<Cs, 512> = Pipe::new();
-/// control → tilt: the slew-limited θd, degrees along the mount's travel (the first one is the
-/// power-up θd: the tilt task sends no pulse before it).
-pub static THETA_D: Signal<Cs, f64> = Signal::new();
+/// control → tilt: the servo's pulse width (µs) for the slew-limited θd, through the
+/// configuration's calibrated map (the first one is the power-up θd's: the tilt task sends no
+/// pulse before it).
+pub static SERVO_US: Signal<Cs, f64> = Signal::new();
 /// control → safety: the control loop completed a tick (the watchdog is fed only then).
 pub static HEARTBEAT: Signal<Cs, ()> = Signal::new();
 /// control → persist: a configuration was accepted; store it.

@@ -2,7 +2,9 @@
 //! configuration record, the pendulum sensor's answers (the AS5047P driver) and the words kept
 //! in RAM across a reset. None may panic on any input; a frame that decodes must re-encode to
 //! the same payload (no two encodings of one message slip through the strict decoder); the
-//! sensor driver reports an angle only with its failure run reset.
+//! sensor driver reports an angle only with its failure run reset. Every request that decodes is
+//! also answered by a rig (`RigServer::respond`): a configuration with any calibration, a
+//! bring-up duty or a start must be refused or taken, never panic.
 
 #![no_main]
 
@@ -19,6 +21,14 @@ fuzz_target!(|data: &[u8]| {
             copy[..stuffed.len()].copy_from_slice(stuffed);
             let len = stuffed.len();
             if let (seq, Ok(req)) = receive_request(stuffed) {
+                let mut rig = kapitza_core::link::serve::RigServer::new(
+                    kapitza_core::rig::config::RigConfig::REFERENCE,
+                    kapitza_core::persist::ConfigOrigin::Stored,
+                    kapitza_core::rig::fixed::Angle::ZERO,
+                    kapitza_core::link::serve::Clock::single(0, 0),
+                    [0, 1, 0],
+                );
+                let _ = rig.respond(req, kapitza_core::link::serve::Clock::single(1000, 1), false);
                 // Re-encode: the same payload as the one accepted.
                 let mut out = [0u8; MAX_REQUEST_FRAME];
                 let n = encode(Header::new(seq), &req, &mut out).expect("fits");

@@ -34,6 +34,8 @@ pub enum Command {
     Monitor(cmd::monitor::Args),
     Demo(cmd::demo::Args),
     Chart(cmd::chart::Args),
+    Flash(cmd::flash::Args),
+    Probes(cmd::probes::Args),
 }
 
 /// What went wrong, and how the process should exit.
@@ -105,6 +107,8 @@ where
         Command::Monitor(a) => cmd::monitor::run(&a, out)?,
         Command::Demo(a) => cmd::demo::run(&a, out)?,
         Command::Chart(a) => cmd::chart::run(&a, out)?,
+        Command::Flash(a) => cmd::flash::run(&a, out)?,
+        Command::Probes(a) => cmd::probes::run(&a, out)?,
     }
     Ok(())
 }

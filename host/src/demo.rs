@@ -233,7 +233,8 @@ impl Driver for Script {
             }
             Phase::Settling { i, need, since_s } => {
                 let tm = state.telemetry?;
-                if tm.commands < need {
+                // A start waits for the rig's pre-run check.
+                if tm.commands < need || tm.mode == Mode::Checking {
                     return None;
                 }
                 if tm.mode != Mode::Running {

@@ -8,6 +8,7 @@
 //! | [`chart`] | the field's charts: stability, equilibria and outcome maps, drawn as PNG and SVG |
 //! | [`cli`] | parsing, dispatch, and the error type that picks the exit status |
 //! | [`demo`] | the lecture demo as a script over the monitor's feed, measured against predicted |
+//! | [`flash`] | flashing the board through a debug probe: the image checked against memory.x first |
 //! | [`input`] | checks of command-line numbers |
 //! | [`link`] | the serial-link client: one method per command; "the line failed" apart from "the rig refused" |
 //! | [`monitor`] | the live monitor: feeds, state machine, dashboard, JSON/CSV records |
@@ -25,6 +26,7 @@ pub mod cli;
 pub mod cmd;
 pub mod csv_out;
 pub mod demo;
+pub mod flash;
 pub mod input;
 pub mod link;
 pub mod monitor;

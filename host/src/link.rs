@@ -20,6 +20,7 @@ use std::time::{Duration, Instant};
 
 use kapitza_core::link::convert::to_q16;
 use kapitza_core::link::frame::{encode, receive_response, Header};
+use kapitza_core::link::message::RawTelemetry;
 use kapitza_core::link::{
     FrameReader, Reason, Request, Response, Status, Telemetry, VersionInfo, MAX_REQUEST_FRAME,
     MAX_RESPONSE_FRAME,
@@ -75,6 +76,7 @@ pub struct Client<P> {
     timeout: Duration,
     tries: u32,
     telemetry: VecDeque<Telemetry>,
+    raw: VecDeque<RawTelemetry>,
 }
 
 /// I16F16 bits of a finite number within ±32768.
@@ -96,6 +98,7 @@ impl<P: Read + Write> Client<P> {
             timeout: Duration::from_millis(500),
             tries: 3,
             telemetry: VecDeque::new(),
+            raw: VecDeque::new(),
         }
     }
 
@@ -177,6 +180,37 @@ impl<P: Read + Write> Client<P> {
                 return Err(Error::Line(LineError::Timeout));
             }
             // Only telemetry is expected: answers to nothing are dropped.
+            let _ = self.poll(0)?;
+        }
+    }
+
+    /// Bring-up mode (from idle): the crank at an open-loop `duty` in [−1, 1) (the rig caps
+    /// it), the servo jogged to θd (degrees); the telemetry stream carries the raw sensors
+    /// instead ([`Client::raw_telemetry`]). [`Client::stop`] leaves it.
+    pub fn bring_up(&mut self, duty: f64, theta_d_deg: f64) -> Result<(), Error> {
+        if !(duty.is_finite() && (-1.0..1.0).contains(&duty)) {
+            return Err(Error::Invalid("the duty must be a number in [-1, 1)"));
+        }
+        let req = Request::BringUp {
+            duty: (duty * 32_768.0).round() as i16,
+            theta_d_deg: q16(
+                theta_d_deg,
+                "the drive angle must be finite, within ±32768°",
+            )?,
+        };
+        self.ok(req)
+    }
+
+    /// The next raw snapshot of bring-up mode, waiting up to the timeout for one.
+    pub fn raw_telemetry(&mut self) -> Result<RawTelemetry, Error> {
+        let deadline = Instant::now() + self.timeout;
+        loop {
+            if let Some(t) = self.raw.pop_front() {
+                return Ok(t);
+            }
+            if Instant::now() >= deadline {
+                return Err(Error::Line(LineError::Timeout));
+            }
             let _ = self.poll(0)?;
         }
     }
@@ -263,6 +297,7 @@ impl<P: Read + Write> Client<P> {
             };
             match receive_response(stuffed) {
                 Ok((_, Response::Telemetry(t))) => self.telemetry.push_back(t),
+                Ok((_, Response::Raw(t))) => self.raw.push_back(t),
                 Ok((h, resp)) if h.seq == seq && seq != 0 => answer = Some(resp),
                 Ok((h, Response::Refused(r))) if h.seq == 0 && r.is_link() && seq != 0 => {
                     answer = Some(Response::Refused(r))

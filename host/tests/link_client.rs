@@ -77,6 +77,17 @@ impl Read for Line {
     }
 }
 
+/// Waits out a start's pre-run check (0.6 s of rig time; each status poll lets ≥ 1 ms pass)
+/// and returns the mode after it.
+fn after_check(c: &mut Client<Line>) -> Mode {
+    loop {
+        let m = c.status().unwrap().mode;
+        if m != Mode::Checking {
+            return m;
+        }
+    }
+}
+
 fn client(rig: Line) -> Client<Line> {
     Client::new(rig).with_timeout(Duration::from_millis(50))
 }
@@ -91,7 +102,8 @@ fn every_command() {
     assert_eq!(s.config, ConfigOrigin::Defaults(Fallback::Missing));
 
     c.set_drive(3.0, 180.0).unwrap();
-    assert_eq!(c.status().unwrap().mode, Mode::Running);
+    assert_eq!(c.status().unwrap().mode, Mode::Checking);
+    assert_eq!(after_check(&mut c), Mode::Running);
     c.stop().unwrap();
     assert!(matches!(c.status().unwrap().mode, Mode::Stopping(_)));
     c.clear_fault().unwrap();
@@ -132,6 +144,7 @@ fn configuration_round_trip() {
     // R = 6 needs ω = ωc √6 = 369.1 rad/s with A = 12 mm (ωc = √(2gℓ)/A = 150.7 rad/s), below
     // the new 400 rad/s limit; R = 8 needs 426.2 rad/s, above it.
     c.set_drive(6.0, 0.0).unwrap();
+    assert_eq!(after_check(&mut c), Mode::Running);
     assert!(matches!(
         c.set_drive(8.0, 0.0),
         Err(Error::Refused(Reason::OmegaAboveLimit { .. }))
@@ -159,8 +172,11 @@ fn a_noisy_line_is_retried_and_never_misapplied() {
     let mut c = client(rig);
     c.set_drive(2.0, 45.0).unwrap();
     let rig = c.into_inner();
-    // The damaged copy was refused (BadCrc) and changed nothing; the retry applied exactly R, θd.
+    // The damaged copy was refused (BadCrc) and changed nothing; the retry applied exactly R, θd
+    // (once its pre-run check passed).
     assert_eq!(rig.frames_in, 2);
+    let mut rig = rig;
+    rig.rig.run(0.7);
     let sup = rig.rig.rig().server().rig.supervisor();
     assert_eq!(sup.mode(), safety::Mode::Running);
     let w = kapitza_core::rig::dds::omega_of_word(sup.target_word());
@@ -228,6 +244,7 @@ fn faulted_within(params: Params, wire: SensorLine, start: bool, ms: u32) -> (Cl
     let mut c = client(Line::on(rig));
     if start {
         c.set_drive(3.0, 0.0).unwrap();
+        after_check(&mut c);
     }
     let mut mode = c.status().unwrap().mode;
     for _ in 0..ms {
@@ -250,8 +267,8 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
         other => panic!("{other:?}"),
     }
     // Swapped crank-encoder channels, and swapped motor leads: the crank turns against the
-    // drive; with the reference limits (ramp 60 rad/s², bar at 20 rad/s, 300 ms debounce) the
-    // fault comes ≈ 0.65 s after the start; 3 s is the bound.
+    // drive. The pre-run check's test pulse sees it before any start and refuses it (the
+    // WrongDirection fault is for a reversal while running: rig_safety, closed_loop_safety).
     for params in [
         Params {
             crank_sign: -1.0,
@@ -266,11 +283,13 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
         },
     ] {
         let (mut c, mode) = faulted_within(params, SensorLine::Connected, true, 3000);
-        assert_eq!(mode, Mode::Faulted(Fault::WrongDirection));
-        match c.set_drive(3.0, 0.0) {
-            Err(Error::Refused(Reason::Faulted(Fault::WrongDirection))) => {}
-            other => panic!("{other:?}"),
-        }
+        assert_eq!(mode, Mode::Idle);
+        assert!(matches!(
+            c.status().unwrap().check,
+            Some(kapitza_core::link::message::Check::Failed(
+                kapitza_core::link::message::Verdict::CrankReversed { .. }
+            ))
+        ));
     }
     // A motor too weak for the set ω: 300 rad/s at full duty (back-EMF matched, so its current
     // stays low) against ω = ωc√3 = 313 rad/s. The crank runs at ≥ 96 % of ω, no stall, but
@@ -289,4 +308,41 @@ fn bench_faults_latch_with_their_reason_and_refuse_a_start() {
     // The same rig wired right runs.
     let (_, mode) = faulted_within(Params::DEMO, SensorLine::Connected, true, 2000);
     assert_eq!(mode, Mode::Running);
+}
+
+#[test]
+fn bring_up_streams_the_raw_sensors() {
+    let mut c = client(Line::new());
+    c.bring_up(0.1, 0.0).unwrap();
+    assert_eq!(c.status().unwrap().bring_up, Some(3_277));
+    c.stream_telemetry(20).unwrap();
+    // Let the motor reach its speed (τ = 60 ms), then 0.5 s of frames: the crank turns
+    // forwards at 0.1 · 450 rad/s (the demo motor), 45/(2π) · 0.5 = 3.58 turns, summed frame
+    // by frame (a 20 ms frame is 0.14 turn, well inside the half turn a wrapped difference
+    // holds).
+    let mut a = c.raw_telemetry().unwrap();
+    while c.raw_telemetry().unwrap().t_us.wrapping_sub(a.t_us) < 300_000 {}
+    a = c.raw_telemetry().unwrap();
+    let (start, mut b, mut turns) = (a, a, 0.0);
+    while b.t_us.wrapping_sub(start.t_us) < 500_000 {
+        let n = c.raw_telemetry().unwrap();
+        turns += f64::from(n.crank.wrapping_sub(b.crank) as i32) / 4_294_967_296.0;
+        b = n;
+    }
+    let secs = f64::from(b.t_us.wrapping_sub(start.t_us)) * 1e-6;
+    let rate = turns / secs;
+    assert!(
+        (rate - 45.0 / std::f64::consts::TAU).abs() < 0.1,
+        "{rate} turns/s"
+    );
+    assert_eq!(b.duty, 3_277);
+    assert!(b.pendulum.is_some() && b.diagnostics.is_some_and(|d| d.ready));
+    // Above the cap: refused by the rig; not a number: not even sent.
+    assert!(matches!(
+        c.bring_up(0.5, 0.0),
+        Err(Error::Refused(Reason::DutyAboveCap { .. }))
+    ));
+    assert!(matches!(c.bring_up(f64::NAN, 0.0), Err(Error::Invalid(_))));
+    c.stop().unwrap();
+    assert_eq!(c.status().unwrap().bring_up, None);
 }

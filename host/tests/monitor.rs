@@ -38,6 +38,8 @@ fn status(mode: Mode, omega_target: f64, theta_d_target: f64, commands: u32) -> 
             ..Counters::default()
         },
         reset: kapitza_core::link::message::ResetInfo::POWER_ON,
+        check: None,
+        bring_up: None,
     }
 }
 
@@ -63,6 +65,7 @@ fn frame(t_s: f64, phi_deg: f64, omega: f64, theta_d: f64, commands: u32) -> Tel
         theta_d_deg: to_q16(theta_d),
         steady: true,
         commands,
+        wobble: 0,
     }
 }
 
@@ -74,7 +77,7 @@ fn running_state() -> State {
     s.on_event(Event::Linked {
         protocol: 2,
         firmware: [0, 1, 0],
-        config: cfg,
+        config: Box::new(cfg),
     });
     s.on_event(Event::Status(status(Mode::Running, omega, 90.0, 1)));
     for k in 0..=300 {
@@ -356,7 +359,7 @@ fn demo_script_waits_for_frames_after_its_command() {
     s.on_event(Event::Linked {
         protocol: 2,
         firmware: [0, 1, 0],
-        config: cfg,
+        config: Box::new(cfg),
     });
     let mut script = Script::new();
     let rest = |t: f64| Telemetry {

@@ -567,3 +567,53 @@ fn configuration_round_trip_and_refusal_by_field() {
     assert_eq!(v["amplitude"], 0.012);
     owner.interrupt();
 }
+
+#[test]
+fn a_reversed_crank_fails_the_pre_run_check_and_set_exits_1_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("reversed.toml");
+    std::fs::write(
+        &file,
+        "[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n\
+         [effects]\nviscous = { q = 10.0 }\n[crank]\nreversed = true\n",
+    )
+    .unwrap();
+    let rig = serve(&["--sim", file.to_str().unwrap()]);
+    let port = rig.first_line.as_str();
+    let o = kapitza(&[
+        "set", "--port", port, "--r", "1.5", "--angle", "0", "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("pre-run check failed") && e.contains("backwards"),
+        "{e}"
+    );
+    let v = json(&o);
+    assert_eq!(v["check"], "failed");
+    assert!(
+        v["check_reason"].as_str().unwrap().contains("crank_sign"),
+        "{v}"
+    );
+    assert_eq!(v["mode"], "idle");
+    // Calibrated for it (the encoder's sign), the same bench starts.
+    let cal = dir.path().join("cal.toml");
+    std::fs::write(&cal, "[calibration]\ncrank_sign = -1\n").unwrap();
+    let o = kapitza(&["config", "set", "--port", port, cal.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let owner = start(&["attach", "--port", port]);
+    let o = kapitza(&["set", "--port", port, "--r", "1.5", "--angle", "0"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let s = json(&kapitza(&["status", "--port", port, "--json"]));
+    assert_eq!(
+        (s["mode"].as_str(), s["check"].as_str()),
+        (Some("running"), Some("passed"))
+    );
+    assert_eq!(s["calibration"]["crank_sign"], -1);
+    owner.interrupt();
+}

@@ -4,8 +4,8 @@
 
 use kapitza_core::link::frame::{encode, open, receive_request, receive_response, Header};
 use kapitza_core::link::message::{
-    Counters, Fault, Mode, RMethod, ResetCause, ResetInfo, StopReason, Telemetry, WireConfig,
-    WireGeometry,
+    Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
+    StopReason, Telemetry, Verdict, WireCalibration, WireClosedLoop, WireConfig, WireGeometry,
 };
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{
@@ -22,7 +22,8 @@ fn fault() -> impl Strategy<Value = Fault> {
         Just(Fault::Sensor),
         Just(Fault::WrongDirection),
         Just(Fault::PhaseLockLost),
-        Just(Fault::OverCurrentRms)
+        Just(Fault::OverCurrentRms),
+        Just(Fault::DutyCeiling)
     ]
 }
 
@@ -40,6 +41,7 @@ fn mode() -> impl Strategy<Value = Mode> {
         Just(Mode::Running),
         stop_reason().prop_map(Mode::Stopping),
         fault().prop_map(Mode::Faulted),
+        Just(Mode::Checking),
     ]
 }
 
@@ -47,6 +49,8 @@ fn field() -> impl Strategy<Value = ConfigField> {
     prop_oneof![
         Just(ConfigField::Amplitude),
         Just(ConfigField::Rates),
+        Just(ConfigField::CrankSign),
+        Just(ConfigField::ClosedLoopRateMax),
         Just(ConfigField::Other),
     ]
 }
@@ -60,7 +64,62 @@ fn geometry() -> impl Strategy<Value = WireGeometry> {
     ]
 }
 
+fn calibration() -> impl Strategy<Value = WireCalibration> {
+    (
+        (
+            any::<u16>(),
+            any::<i8>(),
+            any::<i8>(),
+            any::<u32>(),
+            any::<u32>(),
+        ),
+        (any::<f64>(), any::<f64>(), any::<f64>(), any::<f64>()),
+        (
+            any::<f64>(),
+            any::<f64>(),
+            any::<f64>(),
+            any::<f64>(),
+            any::<u32>(),
+        ),
+    )
+        .prop_map(|(a, b, c)| WireCalibration {
+            pendulum_zero: a.0,
+            pendulum_sign: a.1,
+            crank_sign: a.2,
+            servo_min_us: a.3,
+            servo_max_us: a.4,
+            servo_range_deg: b.0,
+            servo_centre_deg: b.1,
+            current_offset: b.2,
+            current_scale: b.3,
+            hysteresis: c.0,
+            min_swing: c.1,
+            settle_band: c.2,
+            block_s: c.3,
+            quiet_blocks: c.4,
+        })
+}
+
 fn config() -> impl Strategy<Value = WireConfig> {
+    (
+        base_config(),
+        any::<f64>(),
+        calibration(),
+        (any::<bool>(), any::<f64>(), any::<f64>()),
+    )
+        .prop_map(|(mut c, duty_max, calibration, l)| {
+            c.duty_max = duty_max;
+            c.calibration = calibration;
+            c.closed_loop = WireClosedLoop {
+                enabled: l.0,
+                band: l.1,
+                rate_max: l.2,
+            };
+            c
+        })
+}
+
+fn base_config() -> impl Strategy<Value = WireConfig> {
     (
         (
             any::<f64>(),
@@ -108,6 +167,7 @@ fn config() -> impl Strategy<Value = WireConfig> {
             max_correction: d.3,
             sample_hz: e.0,
             control_hz: e.1,
+            ..kapitza_core::rig::config::RigConfig::REFERENCE.into()
         })
 }
 
@@ -122,6 +182,8 @@ fn request() -> impl Strategy<Value = Request> {
         config().prop_map(Request::SetConfig),
         Just(Request::GetConfig),
         any::<u16>().prop_map(|period_ms| Request::Telemetry { period_ms }),
+        (any::<i16>(), any::<i32>())
+            .prop_map(|(duty, theta_d_deg)| Request::BringUp { duty, theta_d_deg }),
     ]
 }
 
@@ -143,6 +205,23 @@ fn reason() -> impl Strategy<Value = Reason> {
         fault().prop_map(Reason::Faulted),
         mode().prop_map(Reason::WrongMode),
         field().prop_map(|field| Reason::ConfigInvalid { field }),
+        Just(Reason::CheckRunning),
+        (any::<i16>(), any::<i16>())
+            .prop_map(|(requested, cap)| Reason::DutyAboveCap { requested, cap }),
+    ]
+}
+
+fn check() -> impl Strategy<Value = Check> {
+    prop_oneof![
+        Just(Check::Running),
+        Just(Check::Passed),
+        Just(Check::Failed(Verdict::SensorSilent)),
+        Just(Check::Failed(Verdict::SensorNotReady)),
+        any::<i32>().prop_map(|amps| Check::Failed(Verdict::CurrentOffset { amps })),
+        any::<i32>().prop_map(|speed| Check::Failed(Verdict::CrankReversed { speed })),
+        any::<i32>().prop_map(|speed| Check::Failed(Verdict::CrankStalled { speed })),
+        any::<i32>().prop_map(|speed| Check::Failed(Verdict::CrankTooFast { speed })),
+        Just(Check::Failed(Verdict::Aborted)),
     ]
 }
 
@@ -162,7 +241,12 @@ fn status() -> impl Strategy<Value = Status> {
         (mode(), proptest::option::of(stop_reason()), any::<bool>()),
         (any::<i32>(), any::<i32>(), any::<i32>(), any::<i32>()),
         (origin(), any::<u32>(), any::<[u32; 6]>()),
-        (reset_cause(), proptest::option::of(fault())),
+        (
+            reset_cause(),
+            proptest::option::of(fault()),
+            proptest::option::of(check()),
+            proptest::option::of(any::<i16>()),
+        ),
     )
         .prop_map(|(a, b, c, r)| Status {
             mode: a.0,
@@ -186,6 +270,8 @@ fn status() -> impl Strategy<Value = Status> {
                 cause: r.0,
                 last_fault: r.1,
             },
+            check: r.2,
+            bring_up: r.3,
         })
 }
 
@@ -226,7 +312,13 @@ fn telemetry() -> impl Strategy<Value = Telemetry> {
             any::<i32>(),
             any::<i16>(),
         ),
-        (any::<i32>(), any::<i32>(), any::<bool>(), any::<u32>()),
+        (
+            any::<i32>(),
+            any::<i32>(),
+            any::<bool>(),
+            any::<u32>(),
+            any::<i32>(),
+        ),
     )
         .prop_map(|(a, b, c, d)| Telemetry {
             t_us: a.0,
@@ -248,6 +340,38 @@ fn telemetry() -> impl Strategy<Value = Telemetry> {
             theta_d_deg: d.1,
             steady: d.2,
             commands: d.3,
+            wobble: d.4,
+        })
+}
+
+fn raw() -> impl Strategy<Value = RawTelemetry> {
+    (
+        (
+            any::<u32>(),
+            proptest::option::of(any::<u16>()),
+            any::<u32>(),
+            any::<u16>(),
+            any::<i16>(),
+        ),
+        proptest::option::of((any::<u8>(), any::<[bool; 4]>())),
+        (any::<u32>(), any::<i32>(), any::<u32>()),
+    )
+        .prop_map(|(a, d, c)| RawTelemetry {
+            t_us: a.0,
+            pendulum: a.1,
+            crank: a.2,
+            current: a.3,
+            duty: a.4,
+            diagnostics: d.map(|(agc, b)| SensorDiagnostics {
+                agc,
+                magnet_low: b[0],
+                magnet_high: b[1],
+                cordic_overflow: b[2],
+                ready: b[3],
+            }),
+            sensor_errors: c.0,
+            theta_d_deg: c.1,
+            commands: c.2,
         })
 }
 
@@ -260,6 +384,7 @@ fn response() -> impl Strategy<Value = Response> {
         status().prop_map(Response::Status),
         config().prop_map(Response::Config),
         telemetry().prop_map(Response::Telemetry),
+        raw().prop_map(Response::Raw),
     ]
 }
 

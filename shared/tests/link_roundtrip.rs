@@ -86,6 +86,21 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
     cfg.link_timeout_ms = u32::MAX;
     cfg.sample_hz = u32::MAX;
     cfg.control_hz = u32::MAX;
+    cfg.calibration.pendulum_zero = u16::MAX;
+    cfg.calibration.servo_min_us = u32::MAX;
+    cfg.calibration.servo_max_us = u32::MAX;
+    cfg.calibration.quiet_blocks = u32::MAX;
+    let raw = kapitza_core::link::message::RawTelemetry {
+        t_us: u32::MAX,
+        pendulum: Some(u16::MAX),
+        crank: u32::MAX,
+        current: u16::MAX,
+        duty: i16::MIN,
+        diagnostics: Some(Default::default()),
+        sensor_errors: u32::MAX,
+        theta_d_deg: i32::MIN,
+        commands: u32::MAX,
+    };
     let t = Telemetry {
         t_us: u32::MAX,
         mode: Mode::Stopping(StopReason::Fault(kapitza_core::link::message::Fault::Stall)),
@@ -106,6 +121,7 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
         theta_d_deg: i32::MIN,
         steady: true,
         commands: u32::MAX,
+        wobble: i32::MIN,
     };
     let mut s: Status = link_samples::status();
     s.last_stop = Some(StopReason::Fault(kapitza_core::link::message::Fault::Stall));
@@ -123,6 +139,10 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
     s.counters.overruns = u32::MAX;
     s.counters.frames_dropped = u32::MAX;
     s.counters.commands = u32::MAX;
+    s.check = Some(kapitza_core::link::message::Check::Failed(
+        kapitza_core::link::message::Verdict::CurrentOffset { amps: i32::MIN },
+    ));
+    s.bring_up = Some(i16::MIN);
     vec![
         (
             "set_config",
@@ -131,6 +151,7 @@ fn worst_cases() -> Vec<(&'static str, Msg, usize)> {
         ),
         ("config", Msg::Resp(Response::Config(cfg)), 0),
         ("telemetry", Msg::Resp(Response::Telemetry(t)), 0),
+        ("raw", Msg::Resp(Response::Raw(raw)), 0),
         ("status", Msg::Resp(Response::Status(s)), 0),
     ]
 }
@@ -164,8 +185,9 @@ fn max_size_bounds_hold_and_are_reached() {
         Request::POSTCARD_MAX_SIZE,
         Response::POSTCARD_MAX_SIZE
     );
-    // A response frame fits a 256-byte buffer; at 115200 baud it takes under 23 ms.
-    const { assert!(MAX_RESPONSE_FRAME <= 256) };
+    // A response frame fits the firmware's 512-byte pipe to the line; at 115200 baud it takes
+    // under 45 ms. (The configuration with its calibration is the largest message.)
+    const { assert!(MAX_RESPONSE_FRAME <= 512) };
 }
 
 #[test]

@@ -253,7 +253,6 @@ fn status_and_telemetry_in_wire_units() {
     let mut srv = RigServer::new(
         CFG,
         ConfigOrigin::Stored,
-        Tuning::DEFAULT,
         Angle::ZERO,
         Clock::single(0, 0),
         [0, 1, 0],
@@ -314,7 +313,6 @@ mod server {
         RigServer::new(
             CFG,
             ConfigOrigin::Defaults(Fallback::Missing),
-            Tuning::DEFAULT,
             Angle::ZERO,
             Clock::single(0, 0),
             [1, 2, 3],
@@ -361,7 +359,24 @@ mod server {
             s.respond(set, Clock::single(50, 0), false),
             (Response::Ok, Effect::None)
         );
-        assert_eq!(s.rig.supervisor().mode(), safety::Mode::Running);
+        // A start from idle waits for its pre-run check (run by the rig loop's control tick).
+        assert_eq!(s.rig.supervisor().mode(), safety::Mode::Idle);
+        assert_eq!(s.check, Some(kapitza_core::link::message::Check::Running));
+        // Anything but a stop is refused meanwhile; a stop aborts it.
+        assert_eq!(
+            s.respond(set, Clock::single(60, 0), false).0,
+            Response::Refused(Reason::CheckRunning)
+        );
+        assert_eq!(
+            s.respond(Request::Stop, Clock::single(70, 0), false).0,
+            Response::Ok
+        );
+        assert_eq!(
+            s.check,
+            Some(kapitza_core::link::message::Check::Failed(
+                kapitza_core::link::message::Verdict::Aborted
+            ))
+        );
     }
 
     #[test]
@@ -381,7 +396,7 @@ mod server {
         assert_eq!(e, Effect::None);
         // Only the link keep-alive moved.
         assert_eq!((s.cfg, s.origin), (before.cfg, before.origin));
-        // Running: refused.
+        // Starting (its pre-run check running): refused.
         s.respond(
             Request::SetDrive {
                 r: q(1.0),
@@ -390,6 +405,20 @@ mod server {
             Clock::single(20, 0),
             false,
         );
+        let (r, _) = s.respond(Request::SetConfig(new.into()), Clock::single(30, 0), false);
+        assert_eq!(r, Response::Refused(Reason::CheckRunning));
+        assert_eq!(s.cfg, CFG);
+        // Running: refused.
+        apply(
+            &mut s.rig,
+            &CFG,
+            Command::SetDrive {
+                r: q(1.0),
+                theta_d_deg: 0,
+            },
+        )
+        .unwrap();
+        s.activity = kapitza_core::link::serve::Activity::None;
         let (r, _) = s.respond(Request::SetConfig(new.into()), Clock::single(30, 0), false);
         assert_eq!(r, Response::Refused(Reason::WrongMode(Mode::Running)));
         assert_eq!(s.cfg, CFG);

@@ -94,6 +94,7 @@ proptest! {
                             drive_stopped: dds.is_stopped(),
                             sensor_failed: false,
                             phase_error: RadPerSec::ZERO,
+                            duty_saturated: false,
                             ramping: false,
                             link_us: t,
                         };
@@ -142,6 +143,7 @@ fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
         drive_stopped: stopped,
         sensor_failed: false,
         phase_error: RadPerSec::ZERO,
+        duty_saturated: false,
         ramping: false,
         link_us: 0,
     }
@@ -403,4 +405,41 @@ fn two_cycle_slips_within_a_second_lose_the_phase_lock() {
     tick(&mut s, 3.0);
     tick(&mut s, -3.0);
     assert_eq!(s.mode(), Mode::Faulted(Fault::PhaseLockLost));
+}
+
+#[test]
+fn a_drive_held_at_the_duty_ceiling_faults_after_the_stall_debounce() {
+    // The phase lock clamped at duty_max on every tick while running: the motor cannot hold the
+    // speed within the duty it may use. Debounced like a stall (REFERENCE: 300 ms at 1 kHz).
+    let cfg = RigConfig::REFERENCE;
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    let mut t = 0;
+    let mut at_ceiling = quiet(100.0, 100.0, false);
+    at_ceiling.duty_saturated = true;
+    latches_after_300_ticks(&mut s, &mut t, &at_ceiling);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::DutyCeiling));
+    assert_eq!(
+        s.request(Request::Start { omega: 300.0 }),
+        Err(Refusal::Faulted(Fault::DutyCeiling))
+    );
+    // Touching the ceiling now and then is no fault: the debounce restarts each time.
+    s.request(Request::ClearFault).unwrap();
+    s.request(Request::Start { omega: 300.0 }).unwrap();
+    for k in 0..2000 {
+        t += 1000;
+        s.heard_from_link(t);
+        let mut inp = quiet(100.0, 100.0, false);
+        inp.duty_saturated = k % 200 != 0;
+        check(&mut s, t, &inp);
+    }
+    assert_eq!(s.mode(), Mode::Running);
+    // Idle at the ceiling (nothing drives): nothing to latch.
+    let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);
+    for _ in 0..1000 {
+        t += 1000;
+        s.heard_from_link(t);
+        check(&mut s, t, &at_ceiling);
+    }
+    assert_eq!(s.mode(), Mode::Idle);
 }

@@ -12,7 +12,7 @@
 //! | H-bridge nFAULT | PA6 | TIM1_BKIN (AF6) | open drain, pulled up: low = fault, TIM1 break (outputs off in hardware) |
 //! | motor current (IPROPI) | PA0 | ADC1_IN1 | 1.5 kΩ to ground: 0.6825 V/A |
 //! | crank encoder A / B | PB6 / PB7 | TIM4_CH1/CH2, encoder mode | 2048 lines, 8192 counts per turn |
-//! | tilt servo | PB4 | TIM3_CH1, 50 Hz | 500–2500 µs over 270° |
+//! | tilt servo | PB4 | TIM3_CH1, 50 Hz | pulse map from the calibration (reference: 500–2500 µs over 270°) |
 //! | pendulum encoder SCK / MISO / MOSI | PB13 / PB14 / PB15 | SPI2, mode 1, 5.3 MHz | AS5047P, 14 bit; MISO pulled up (a cut cable reads 0xFFFF) |
 //! | pendulum encoder CSn | PB12 | GPIO out | |
 //! | emergency stop | PB1 | GPIO in, pull-up (+ external 4.7 kΩ and RC) | normally-closed contact to GND: open = stop; read at every control tick |
@@ -34,7 +34,6 @@ use embassy_stm32::timer::qei::{self, Qei};
 use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm, SimplePwmChannel};
 use embassy_stm32::usart::{self, BufferedUart};
 use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config, Peri, Peripherals};
-use kapitza_core::rig::servo::ServoMap;
 use static_cell::StaticCell;
 
 pub const NAME: &str = "NUCLEO-G474RE";
@@ -59,20 +58,30 @@ unsafe fn UART4() {
 /// datasheet's tL, tH and tCSn are ≥ 350 ns ("SPI Timing"), 60 cycles at 170 MHz (352 ns).
 const CS_CYCLES: u32 = 60;
 
-/// SYSCLK = 170 MHz (the G474's maximum) from the internal 16 MHz HSI.
+/// SYSCLK = 170 MHz (the G474's maximum) from the board's 24 MHz crystal X3 (HSE).
 ///
-/// PLL: 16 MHz / 4 = 4 MHz input (allowed 2.66..16 MHz), × 85 = 340 MHz VCO (allowed
+/// Why the crystal: the HSI is ±1 % over temperature (STM32G474 datasheet, "HSI16"), and the
+/// drive's ω is counted in this clock, so R ∝ ω² would be off by up to ±2 %; a crystal is tens
+/// of ppm. The NUCLEO-G474RE (MB1367) carries X3 = 24 MHz fitted and wired to OSC_IN/OSC_OUT by
+/// default (docs/hardware.md, "Clock", for the sources). HSE in oscillator mode (HSEBYP = 0),
+/// not bypass: it is a crystal, not the ST-LINK's MCO.
+///
+/// PLL: 24 MHz / 6 = 4 MHz input (allowed 2.66..16 MHz), × 85 = 340 MHz VCO (allowed
 /// 96..344 MHz), / 2 on the R output = 170 MHz SYSCLK. Above 150 MHz the core regulator must be in
 /// range 1 boost mode. AHB and both APBs run undivided at 170 MHz (all allow up to 170 MHz).
-/// The HSI is used rather than the board's HSE so the firmware does not depend on the NUCLEO's
-/// crystal/solder-bridge configuration. ADC1/2 run from SYSCLK (divided below 60 MHz by the
-/// driver).
+/// ADC1/2 run from SYSCLK (divided below 60 MHz by the driver). embassy-stm32 waits for HSERDY
+/// before anything else runs: a board without its crystal hangs here, before the watchdog
+/// starts, with the bridge asleep (nSLEEP has its pull-down) — the bring-up checklist's first
+/// step shows it.
 pub fn chip_config() -> Config {
     let mut config = Config::default();
-    config.rcc.hsi = true;
+    config.rcc.hse = Some(rcc::Hse {
+        freq: Hertz(24_000_000),
+        mode: rcc::HseMode::Oscillator,
+    });
     config.rcc.pll = Some(rcc::Pll {
-        source: rcc::PllSource::HSI,
-        prediv: rcc::PllPreDiv::DIV4,
+        source: rcc::PllSource::HSE,
+        prediv: rcc::PllPreDiv::DIV6,
         mul: rcc::PllMul::MUL85,
         divp: None,
         divq: None,
@@ -88,28 +97,20 @@ pub fn chip_config() -> Config {
 }
 
 /// Crank encoder counts per turn (4 × 2048 lines). A power of two that divides 2^16, so the
-/// 16-bit counter's wrap stays a whole number of turns.
+/// 16-bit counter's wrap stays a whole number of turns. (The bench's measured constants — the
+/// pendulum sensor's zero and sign, the crank's sign, the servo's pulse map, the current
+/// sense's offset and gain — are not build constants: they are the configuration's
+/// calibration, set over the link and stored in flash.)
 pub const CRANK_COUNTS: u32 = 8192;
-/// Motor current per ADC count (A): 3.3 V / 4096 / (455 µA/A · 1.5 kΩ), in I16F16 bits.
-/// (DRV8874 datasheet: A_IPROPI = 455 µA/A typical.)
-pub const AMPS_PER_COUNT_Q16: i32 = 77; // 3.3/4096/0.6825 A = 1.1805e-3 A → ·65536 = 77.4
-/// Pendulum encoder: its count when the pendulum hangs at rest (θ = 0), and +1 if its count
-/// grows counter-clockwise as seen from the front (SPEC §2), −1 if clockwise. Set when the magnet
-/// is mounted (docs/hardware.md, "Calibration").
-pub const PENDULUM_ZERO: u16 = 0;
-pub const PENDULUM_SIGN: i8 = 1;
 /// The flash page that holds the configuration record: offset from the flash base, and size.
 /// `persist.x` asserts that the program image stays below it.
 pub const CONFIG_PAGE_OFFSET: u32 = 0x7_F800;
 pub const CONFIG_PAGE_SIZE: u32 = 2048;
-/// Tilt servo: pulse width at the two ends of its 270° range, and the angle θd (deg) the middle
-/// of the range points the drive at.
-pub const SERVO_MAP: ServoMap = ServoMap {
-    min_us: 500,
-    max_us: 2500,
-    range_deg: 270.0,
-    centre_deg: 90.0,
-};
+/// The widest pulse range any servo calibration may ask for (µs): the configuration's own
+/// range is checked when it is set (`kapitza_core::rig::calibration`), this is the board's last
+/// word.
+const SERVO_MIN_US: f64 = 400.0;
+const SERVO_MAX_US: f64 = 2600.0;
 
 /// The crank motor's hardware: H-bridge, encoder, current sense, and the e-stop line read at
 /// each control tick.
@@ -158,12 +159,13 @@ pub struct Tilt {
 }
 
 impl Tilt {
-    /// Servo pulse width in µs (clamped to the servo's range); the first call starts the pulses.
-    pub fn set_pulse_us(&mut self, us: u32) {
-        let us = us.clamp(SERVO_MAP.min_us, SERVO_MAP.max_us);
-        // 50 Hz: 20 000 µs per period.
-        let max = self.pwm.max_duty_cycle();
-        self.pwm.set_duty_cycle(us * max / 20_000);
+    /// Servo pulse width in µs (clamped to what any servo takes); the first call starts the
+    /// pulses.
+    pub fn set_pulse_us(&mut self, us: f64) {
+        let us = us.clamp(SERVO_MIN_US, SERVO_MAX_US);
+        // 50 Hz: 20 000 µs per period, in the timer's counts (rounded).
+        let max = f64::from(self.pwm.max_duty_cycle());
+        self.pwm.set_duty_cycle((us * max / 20_000.0 + 0.5) as u32);
         self.pwm.enable();
     }
 }

@@ -7,8 +7,8 @@
 //! ```text
 //! every sample (from the pendulum task):  loop.sample
 //! when it says a control tick is due:     bytes from the link task → loop.receive (answered now)
-//!                                         loop.control(crank, current, e-stop pin) → duty
-//!                                         bridge enable, θd to the servo, a configuration to
+//!                                         loop.control(encoder, ADC counts, e-stop pin) → duty
+//!                                         bridge enable, servo pulse, a configuration to
 //!                                         store, heartbeat to the watchdog, θd and the last
 //!                                         fault to the retained RAM
 //!                                         loop.transmit → frame bytes to the link task
@@ -19,15 +19,14 @@
 use kapitza_core::link::message::ResetInfo;
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
-use kapitza_core::rig::fixed::{Amps, Angle, Duty};
-use kapitza_core::rig::phase_lock::Motor;
+use kapitza_core::rig::fixed::{Angle, Duty};
 use kapitza_core::rig::retained::Retained;
 use kapitza_core::rig::safety::Mode;
 use kapitza_core::station::RigLoop;
 
-use crate::board::{Drive, AMPS_PER_COUNT_Q16, CRANK_COUNTS};
+use crate::board::{Drive, CRANK_COUNTS};
 use crate::channels::{
-    CONFIG_SAVED, FROM_LAPTOP, HEARTBEAT, LINE_ERROR, SAMPLES, SAMPLE_HZ, SAVE_CONFIG, THETA_D,
+    CONFIG_SAVED, FROM_LAPTOP, HEARTBEAT, LINE_ERROR, SAMPLES, SAMPLE_HZ, SAVE_CONFIG, SERVO_US,
     TO_LAPTOP,
 };
 use crate::retained;
@@ -50,19 +49,18 @@ const fn parse_u16(s: &str) -> u16 {
     v
 }
 
-/// The crank motor behind the phase lock's three-method trait.
+/// The crank motor's hardware as the rig loop reads it: raw, calibrated in the loop.
 struct Hw<'a> {
     drive: &'a mut Drive,
 }
 
-impl Motor for Hw<'_> {
-    fn crank_angle(&mut self) -> Angle {
+impl kapitza_core::station::drive::Drive for Hw<'_> {
+    fn crank_raw(&mut self) -> Angle {
         // count · 2^32 / CRANK_COUNTS, exact (CRANK_COUNTS is a power of two).
         Angle::from_turns_u32(self.drive.crank_count() * (u32::MAX / CRANK_COUNTS + 1))
     }
-    fn current(&mut self) -> Amps {
-        let counts = i32::from(self.drive.current_counts());
-        Amps::from_bits(counts.saturating_mul(AMPS_PER_COUNT_Q16))
+    fn current_counts(&mut self) -> u16 {
+        self.drive.current_counts()
     }
     fn set_duty(&mut self, duty: Duty) {
         self.drive.set_duty(duty.to_bits());
@@ -111,8 +109,10 @@ pub async fn run(
         drive.enable(tick.bridge);
         let before = keep;
         if let Some(deg) = tick.servo_deg {
-            THETA_D.signal(deg);
             keep.theta_d_deg = deg as f32;
+        }
+        if let Some(us) = tick.servo_us {
+            SERVO_US.signal(us);
         }
         if let Mode::Faulted(f) = tick.report.mode {
             keep.last_fault = Some(f);

@@ -1,17 +1,16 @@
 //! The pendulum sensor: an AS5047P on SPI, read at the sample rate.
 //!
-//! The frames, the error flag and its clearing read, the diagnostics, the sensor's health and
-//! the count → angle map are `kapitza_core::rig::as5047`; this task keeps the sample clock and
-//! moves the words. Missed sample times are skipped, never caught up in a burst
+//! The frames, the error flag and its clearing read, the diagnostics and the sensor's health
+//! are `kapitza_core::rig::as5047`, the count → angle map the rig loop's (with the
+//! configuration's calibration); this task keeps the sample clock and moves the words. Missed sample times are skipped, never caught up in a burst
 //! (`kapitza_core::station::next_due`), and the sample after a skip is marked late (an overrun
 //! in the status). Each sample carries the time its angle was latched (the frame before).
 
 use embassy_time::{Duration, Instant, Timer};
-use kapitza_core::rig::as5047::{self, As5047};
-use kapitza_core::rig::fixed::Angle;
+use kapitza_core::rig::as5047::As5047;
 use kapitza_core::station::{next_due, Sample};
 
-use crate::board::{PendulumBus, PENDULUM_SIGN, PENDULUM_ZERO};
+use crate::board::PendulumBus;
 use crate::channels::{SAMPLES, SAMPLE_HZ};
 
 fn period(hz: u32) -> Duration {
@@ -23,7 +22,7 @@ pub async fn run(mut bus: PendulumBus, sample_hz: u32) {
     let mut hz = defmt::unwrap!(SAMPLE_HZ.receiver());
     let mut dt = period(sample_hz).as_ticks();
     let mut sensor = As5047::new();
-    let mut held = Angle::ZERO;
+    let mut held = 0u16;
     let mut late = false;
     // The sensor answers 10 ms after its supply comes up (AS5047P datasheet, "power-up time"
     // tPwrUp); frames before that would count towards a sensor fault at every boot.
@@ -42,14 +41,15 @@ pub async fn run(mut bus: PendulumBus, sample_hz: u32) {
         }
         let read = sensor.sample(Instant::now().as_micros() as u32, |w| bus.transfer(w));
         if let Ok(count) = read.count {
-            held = as5047::angle(count, PENDULUM_ZERO, PENDULUM_SIGN);
+            held = count;
         }
         let s = Sample {
             t_us: read.t_us,
-            angle: held,
+            count: held,
             failed: read.count.is_err(),
             late,
             sensor_failed: sensor.health().failed(),
+            diagnostics: sensor.health().diagnostics,
         };
         // A full queue means the control loop is behind: the sample is lost and the next one
         // says so (no log line here: this runs 10 000 times a second).

@@ -10,7 +10,11 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, Context, Result};
 use kapitza_core::model::Geometry;
+use kapitza_core::rig::calibration::Calibration;
+use kapitza_core::rig::closed_loop::ClosedLoopR;
 use kapitza_core::rig::config::{Limits, MotorConfig, RigConfig};
+use kapitza_core::rig::estimator::Tuning;
+use kapitza_core::rig::servo::ServoMap;
 use serde::{Deserialize, Serialize};
 
 use super::rig_args::RigArgs;
@@ -53,6 +57,8 @@ struct ConfigFile {
     pendulum: PendulumFile,
     limits: LimitsFile,
     motor: MotorFile,
+    calibration: CalibrationFile,
+    closed_loop: ClosedLoopFile,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -77,6 +83,41 @@ struct LimitsFile {
     stall_fraction: f64,
     stall_ms: u32,
     link_timeout_ms: u32,
+    duty_max: f64,
+}
+
+/// The bench's calibration (`kapitza_core::rig::calibration`), as `config get` and
+/// `status --json` print it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationFile {
+    /// Pendulum sensor count at rest (0..16383), and +1/−1 for its direction.
+    pendulum_zero: u16,
+    pendulum_sign: i8,
+    /// +1/−1: the crank encoder counts with positive duty, or against it.
+    crank_sign: i8,
+    servo_min_us: u32,
+    servo_max_us: u32,
+    servo_range_deg: f64,
+    servo_centre_deg: f64,
+    /// Current sense: ADC counts at zero current, and A per count.
+    current_offset: f64,
+    current_scale: f64,
+    /// Estimator thresholds (rad, s, blocks).
+    hysteresis: f64,
+    min_swing: f64,
+    settle_band: f64,
+    block_s: f64,
+    quiet_blocks: u32,
+}
+
+/// Closed-loop R (carried; off by default).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ClosedLoopFile {
+    enabled: bool,
+    band: f64,
+    rate_max: f64,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -117,6 +158,7 @@ impl From<&RigConfig> for ConfigFile {
                 stall_fraction: l.stall_fraction,
                 stall_ms: l.stall_ms,
                 link_timeout_ms: l.link_timeout_ms,
+                duty_max: l.duty_max,
             },
             motor: MotorFile {
                 omega_per_duty: m.omega_per_duty,
@@ -124,6 +166,12 @@ impl From<&RigConfig> for ConfigFile {
                 kp: m.kp,
                 ki: m.ki,
                 max_correction: m.max_correction,
+            },
+            calibration: CalibrationFile::from(&c.calibration),
+            closed_loop: ClosedLoopFile {
+                enabled: c.closed_loop.enabled,
+                band: c.closed_loop.band,
+                rate_max: c.closed_loop.rate_max,
             },
         }
     }
@@ -157,6 +205,7 @@ impl From<&ConfigFile> for RigConfig {
                 stall_fraction: l.stall_fraction,
                 stall_ms: l.stall_ms,
                 link_timeout_ms: l.link_timeout_ms,
+                duty_max: l.duty_max,
             },
             motor: MotorConfig {
                 omega_per_duty: m.omega_per_duty,
@@ -164,6 +213,58 @@ impl From<&ConfigFile> for RigConfig {
                 kp: m.kp,
                 ki: m.ki,
                 max_correction: m.max_correction,
+            },
+            calibration: Calibration::from(&f.calibration),
+            closed_loop: ClosedLoopR {
+                enabled: f.closed_loop.enabled,
+                band: f.closed_loop.band,
+                rate_max: f.closed_loop.rate_max,
+            },
+        }
+    }
+}
+
+impl From<&Calibration> for CalibrationFile {
+    fn from(c: &Calibration) -> Self {
+        Self {
+            pendulum_zero: c.pendulum_zero,
+            pendulum_sign: c.pendulum_sign,
+            crank_sign: c.crank_sign,
+            servo_min_us: c.servo.min_us,
+            servo_max_us: c.servo.max_us,
+            servo_range_deg: c.servo.range_deg,
+            servo_centre_deg: c.servo.centre_deg,
+            current_offset: c.current_offset,
+            current_scale: c.current_scale,
+            hysteresis: c.estimator.hysteresis,
+            min_swing: c.estimator.min_swing,
+            settle_band: c.estimator.settle_band,
+            block_s: c.estimator.block_s,
+            quiet_blocks: c.estimator.quiet_blocks,
+        }
+    }
+}
+
+impl From<&CalibrationFile> for Calibration {
+    fn from(f: &CalibrationFile) -> Self {
+        Self {
+            pendulum_zero: f.pendulum_zero,
+            pendulum_sign: f.pendulum_sign,
+            crank_sign: f.crank_sign,
+            servo: ServoMap {
+                min_us: f.servo_min_us,
+                max_us: f.servo_max_us,
+                range_deg: f.servo_range_deg,
+                centre_deg: f.servo_centre_deg,
+            },
+            current_offset: f.current_offset,
+            current_scale: f.current_scale,
+            estimator: Tuning {
+                hysteresis: f.hysteresis,
+                min_swing: f.min_swing,
+                settle_band: f.settle_band,
+                block_s: f.block_s,
+                quiet_blocks: f.quiet_blocks,
             },
         }
     }

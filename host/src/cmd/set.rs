@@ -1,5 +1,7 @@
 //! `kapitza set`: drive strength R and drive angle θd.
 //!
+//! A start from idle waits for the rig's pre-run check: a failed check exits 1 with its reason
+//! (with `--json`, the status printed first, `check` = `"failed"` and `check_reason`).
 //! Through a running owner of the port (`kapitza attach`, `kapitza monitor`) it returns once
 //! the rig has taken the command, or with `--wait` once the pendulum has settled. On its own it
 //! owns the port and stays attached, printing the status as it changes, until the pendulum has
@@ -10,7 +12,7 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
-use kapitza_core::link::message::Mode;
+use kapitza_core::link::message::{Check, Mode};
 use kapitza_core::link::Telemetry;
 
 use super::rig_args::RigArgs;
@@ -43,6 +45,8 @@ pub struct Args {
     pub json: bool,
 }
 
+/// The pre-run check takes 0.6 s of rig time; a verdict later than this means a lost rig.
+const CHECK_TIMEOUT: Duration = Duration::from_secs(5);
 /// How often the link is kept alive while waiting.
 const KEEP_ALIVE: Duration = Duration::from_millis(250);
 /// A progress line at least this often, and whenever the stage changes.
@@ -64,7 +68,23 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let timeout = crate::input::positive("--timeout", args.timeout)?;
     rig::catch_interrupt();
     let mut s = args.rig.connect()?;
+    let starts = args.r > 0.0 && s.call(|c| c.status())?.mode == Mode::Idle;
     s.call(|c| c.set_drive(args.r, args.angle))?;
+    if starts {
+        if let Err(why) = await_check(&mut s)? {
+            if args.json {
+                writeln!(out, "{}", serde_json::to_string_pretty(&s.snapshot()?)?)?;
+            }
+            return Err(Failure::new(
+                Exit::Refused,
+                format!(
+                    "{}: the drive did not start: the pre-run check failed: {why}",
+                    s.name
+                ),
+            )
+            .into());
+        }
+    }
     let after = s.call(|c| c.status())?.counters.commands;
     let mut progress: Box<dyn Write> = if args.json {
         Box::new(std::io::stderr())
@@ -95,6 +115,29 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         writeln!(out, "{}", view.text())?;
     }
     Ok(())
+}
+
+/// A start from idle runs the rig's pre-run check first: waits for its verdict (the status
+/// polled, which also keeps the link alive). `Err` carries the reason it failed.
+fn await_check(s: &mut Session) -> Result<Result<(), String>> {
+    let deadline = Instant::now() + CHECK_TIMEOUT;
+    loop {
+        let st = s.call(|c| c.status())?;
+        match st.check {
+            Some(Check::Running) => {}
+            Some(Check::Passed) => return Ok(Ok(())),
+            Some(Check::Failed(v)) => return Ok(Err(v.to_string())),
+            None => return Ok(Err("the rig did not run its pre-run check".into())),
+        }
+        if Instant::now() >= deadline {
+            return Err(Failure::new(
+                Exit::NoRig,
+                format!("{}: no verdict from the pre-run check", s.name),
+            )
+            .into());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
 }
 
 /// Follows the rig until the pendulum has settled after command number `after` (returns true),

@@ -18,7 +18,7 @@ pub enum Event {
     Linked {
         protocol: u8,
         firmware: [u16; 3],
-        config: RigConfig,
+        config: Box<RigConfig>,
     },
     Telemetry(Telemetry),
     /// The answer to the keep-alive.

@@ -35,7 +35,7 @@ fn linked(o: &mut Owner) -> Option<Event> {
     o.session().map(|s| Event::Linked {
         protocol: s.version.protocol,
         firmware: s.version.firmware,
-        config: s.config,
+        config: Box::new(s.config),
     })
 }
 

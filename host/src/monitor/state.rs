@@ -184,7 +184,7 @@ impl State {
                     "link up: protocol {protocol}, firmware {a}.{b}.{c}"
                 ));
                 self.link = Link::Up { protocol, firmware };
-                self.config = Some(config);
+                self.config = Some(*config);
                 self.last_us = None;
             }
             Event::Telemetry(t) => self.on_telemetry(t),

@@ -13,6 +13,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use kapitza_core::math;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::simrig::plant::MotorModel;
+use kapitza_core::simrig::sensor::Line;
 use kapitza_core::simrig::Params;
 use serde::Deserialize;
 
@@ -122,6 +123,20 @@ struct RawSensor {
     zero_deg: Option<f64>,
     #[serde(default)]
     reversed: bool,
+    #[serde(default)]
+    line: RawLine,
+}
+
+/// The pendulum sensor's cable.
+#[derive(Debug, Default, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum RawLine {
+    #[default]
+    Connected,
+    /// Cut, with MISO's pull-up as on the board: every bit reads 1.
+    Cut,
+    /// Cut with MISO floating low: every bit reads 0.
+    StuckLow,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -134,6 +149,8 @@ struct RawMotor {
     ohms: Option<f64>,
     #[serde(default)]
     reversed: bool,
+    #[serde(default)]
+    stalled: bool,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -168,6 +185,64 @@ struct RawConfigured {
     pendulum: Option<RawPendulum>,
     amplitude: Option<f64>,
     gravity: Option<f64>,
+    duty_max: Option<f64>,
+    #[serde(default)]
+    calibration: RawCalibration,
+    #[serde(default)]
+    closed_loop: RawClosedLoop,
+}
+
+/// `[configured.calibration]`: any of the calibration's fields (`kapitza config get` names).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [configured.calibration]")]
+struct RawCalibration {
+    pendulum_zero: Option<u16>,
+    pendulum_sign: Option<i8>,
+    crank_sign: Option<i8>,
+    servo_min_us: Option<u32>,
+    servo_max_us: Option<u32>,
+    servo_range_deg: Option<f64>,
+    servo_centre_deg: Option<f64>,
+    current_offset: Option<f64>,
+    current_scale: Option<f64>,
+    hysteresis: Option<f64>,
+    min_swing: Option<f64>,
+    settle_band: Option<f64>,
+    block_s: Option<f64>,
+    quiet_blocks: Option<u32>,
+}
+
+/// `[configured.closed_loop]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [configured.closed_loop]")]
+struct RawClosedLoop {
+    enabled: Option<bool>,
+    band: Option<f64>,
+    rate_max: Option<f64>,
+}
+
+impl RawCalibration {
+    fn apply(&self, c: &mut kapitza_core::rig::calibration::Calibration) {
+        fn set<T: Copy>(to: &mut T, v: Option<T>) {
+            if let Some(v) = v {
+                *to = v;
+            }
+        }
+        set(&mut c.pendulum_zero, self.pendulum_zero);
+        set(&mut c.pendulum_sign, self.pendulum_sign);
+        set(&mut c.crank_sign, self.crank_sign);
+        set(&mut c.servo.min_us, self.servo_min_us);
+        set(&mut c.servo.max_us, self.servo_max_us);
+        set(&mut c.servo.range_deg, self.servo_range_deg);
+        set(&mut c.servo.centre_deg, self.servo_centre_deg);
+        set(&mut c.current_offset, self.current_offset);
+        set(&mut c.current_scale, self.current_scale);
+        set(&mut c.estimator.hysteresis, self.hysteresis);
+        set(&mut c.estimator.min_swing, self.min_swing);
+        set(&mut c.estimator.settle_band, self.settle_band);
+        set(&mut c.estimator.block_s, self.block_s);
+        set(&mut c.estimator.quiet_blocks, self.quiet_blocks);
+    }
 }
 
 fn in_range(key: &str, v: f64, lo: f64, hi: f64, allowed: &str) -> Result<f64> {
@@ -287,6 +362,12 @@ fn convert(raw: RawRig) -> Result<RigFile> {
             5.0,
             "in [-5, 5] A",
         )?,
+        stalled: m.stalled,
+        sensor_line: match raw.sensor.line {
+            RawLine::Connected => Line::Connected,
+            RawLine::Cut => Line::CutPulledUp,
+            RawLine::StuckLow => Line::CutPulledDown,
+        },
         theta0: math::to_rad(in_range(
             "initial.angle_deg",
             raw.initial.angle_deg.unwrap_or(0.0),
@@ -307,6 +388,15 @@ fn convert(raw: RawRig) -> Result<RigFile> {
         if let Some(g) = c.gravity {
             config.gravity = positive("configured.gravity", g)?;
         }
+        if let Some(d) = c.duty_max {
+            config.limits.duty_max = d;
+        }
+        c.calibration.apply(&mut config.calibration);
+        let l = &c.closed_loop;
+        let cl = &mut config.closed_loop;
+        cl.enabled = l.enabled.unwrap_or(cl.enabled);
+        cl.band = l.band.unwrap_or(cl.band);
+        cl.rate_max = l.rate_max.unwrap_or(cl.rate_max);
     }
     let config = config.validate().map_err(|e| anyhow!("configured: {e}"))?;
     if amplitude > 0.1 * ell {
@@ -338,6 +428,31 @@ mod tests {
         let f = parse(include_str!("../../../rigs/mistyped.toml")).unwrap();
         assert_ne!(f.config.geometry, f.params.geometry);
         assert_eq!(f.params.sensor_zero, math::to_rad(1.5));
+    }
+
+    #[test]
+    fn bench_faults_and_calibration_are_read() {
+        let f = parse(
+            "[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n\
+             [sensor]\nline = \"stuck_low\"\n[motor]\nstalled = true\n[crank]\nreversed = true\n\
+             [configured]\nduty_max = 0.5\n[configured.calibration]\ncrank_sign = -1\n\
+             current_offset = 12.0\n[configured.closed_loop]\nenabled = true\n",
+        )
+        .unwrap();
+        assert_eq!(f.params.sensor_line, Line::CutPulledDown);
+        assert!(f.params.stalled);
+        assert_eq!(f.params.crank_sign, -1.0);
+        assert_eq!(f.config.limits.duty_max, 0.5);
+        assert_eq!(f.config.calibration.crank_sign, -1);
+        assert_eq!(f.config.calibration.current_offset, 12.0);
+        assert!(f.config.closed_loop.enabled);
+        // Out of range: named by the configuration's check.
+        let e = parse(
+            "[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n\
+             [configured.calibration]\ncrank_sign = 0\n",
+        )
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("crank_sign"), "{e:#}");
     }
 
     #[test]

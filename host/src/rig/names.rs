@@ -10,6 +10,7 @@ pub fn mode_name(m: &Mode) -> &'static str {
         Mode::Running => "running",
         Mode::Stopping(_) => "stopping",
         Mode::Faulted(_) => "faulted",
+        Mode::Checking => "checking",
     }
 }
 
@@ -22,6 +23,7 @@ pub fn fault_name(f: &Fault) -> &'static str {
         Fault::WrongDirection => "wrong_direction",
         Fault::PhaseLockLost => "phase_lock_lost",
         Fault::OverCurrentRms => "over_current_rms",
+        Fault::DutyCeiling => "duty_ceiling",
     }
 }
 

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use kapitza_core::link::convert::from_q16;
-use kapitza_core::link::message::Mode;
+use kapitza_core::link::message::{Check, Mode};
 use kapitza_core::link::{Status, Telemetry, VersionInfo, PROTOCOL_VERSION};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
@@ -62,6 +62,19 @@ pub fn open(target: &Target, sim: &SimOptions) -> Result<Session> {
 pub fn check(port: Box<dyn ReadWrite>, name: String, via_owner: bool) -> Result<Session> {
     let mut client = Client::new(port).with_timeout(ANSWER_TIMEOUT);
     let version = client.version().map_err(|e| line_failure(&name, e))?;
+    check_version(&version, &name)?;
+    let config = client.config().map_err(|e| line_failure(&name, e))?;
+    Ok(Session {
+        client,
+        version,
+        config,
+        name,
+        via_owner,
+    })
+}
+
+/// Refuses a rig that speaks another link protocol than this host tool.
+pub fn check_version(version: &VersionInfo, name: &str) -> Result<()> {
     if version.protocol != PROTOCOL_VERSION {
         return Err(Failure::new(
             Exit::NoRig,
@@ -74,14 +87,7 @@ pub fn check(port: Box<dyn ReadWrite>, name: String, via_owner: bool) -> Result<
         )
         .into());
     }
-    let config = client.config().map_err(|e| line_failure(&name, e))?;
-    Ok(Session {
-        client,
-        version,
-        config,
-        name,
-        via_owner,
-    })
+    Ok(())
 }
 
 /// A failed call in terms of its exit status: refused (1) or the line (3).
@@ -176,6 +182,16 @@ pub struct StatusView {
     pub frames_dropped: u32,
     pub sensor_errors: u32,
     pub overruns: u32,
+    /// The pre-run check of the last start: `"running"`, `"passed"`, `"failed"`, or null
+    /// before any; with the reason it failed.
+    pub check: Option<&'static str>,
+    pub check_reason: Option<String>,
+    /// In bring-up mode: its open-loop duty; else null.
+    pub bring_up_duty: Option<f64>,
+    /// The fast wobble's amplitude at the drive frequency (rad), from the telemetry.
+    pub wobble_rad: Option<f64>,
+    /// The rig's calibration (as `kapitza config get` prints it).
+    pub calibration: crate::cmd::config::CalibrationFile,
 }
 
 impl StatusView {
@@ -224,6 +240,18 @@ impl StatusView {
             frames_dropped: s.counters.frames_dropped,
             sensor_errors: s.counters.sensor_errors,
             overruns: s.counters.overruns,
+            check: s.check.map(|c| match c {
+                Check::Running => "running",
+                Check::Passed => "passed",
+                Check::Failed(_) => "failed",
+            }),
+            check_reason: match s.check {
+                Some(Check::Failed(v)) => Some(v.to_string()),
+                _ => None,
+            },
+            bring_up_duty: s.bring_up.map(|d| f64::from(d) / 32_768.0),
+            wobble_rad: t.map(|t| from_q16(t.wobble)),
+            calibration: (&cfg.calibration).into(),
         }
     }
 
@@ -263,6 +291,16 @@ impl StatusView {
                 "\n            R in situ = {r:.3} (requested {:.3})",
                 self.r_target
             );
+        }
+        match (self.check, &self.check_reason) {
+            (Some("failed"), Some(why)) => {
+                s += &format!("\ncheck       pre-run check failed: {why}")
+            }
+            (Some(c), _) => s += &format!("\ncheck       pre-run check {c}"),
+            _ => {}
+        }
+        if let Some(d) = self.bring_up_duty {
+            s += &format!("\nbring-up    open-loop duty {d:.3}");
         }
         if self.reset_cause != "power_on" {
             s += &format!(

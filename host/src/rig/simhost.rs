@@ -20,7 +20,8 @@ use std::sync::mpsc::{
 use std::time::{Duration, Instant};
 
 use kapitza_core::link::convert::deg_along_travel;
-use kapitza_core::link::serve::RigServer;
+use kapitza_core::link::message::Check;
+use kapitza_core::link::serve::{Activity, RigServer};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::dds::omega_of_word;
 use kapitza_core::simrig::SimRig;
@@ -74,7 +75,9 @@ pub trait Line {
     fn give(&mut self, buf: &[u8]) -> io::Result<usize>;
 }
 
-/// One setting the rig applied, for the truth log: written whenever its command counter moves.
+/// One setting the rig applied, for the truth log: written whenever its command counter moves,
+/// except for a start waiting for its pre-run check, which is written when it passes (a start
+/// whose check fails applies nothing).
 #[derive(Debug, Clone, Serialize)]
 pub struct Applied {
     /// Rig seconds since power-up.
@@ -125,6 +128,7 @@ pub fn run(
     let mut out = [0u8; 256];
     let (mut out_from, mut out_to) = (0, 0);
     let mut commands = sim.counters().commands;
+    let mut check = None;
     while !stop() {
         let wall = start.elapsed();
         let link_us = Some(wall.as_micros() as u32);
@@ -137,7 +141,16 @@ pub fn run(
         }
         if let Some(w) = truth.as_deref_mut() {
             let now = sim.counters().commands;
-            if now != commands {
+            let srv = sim.rig().server();
+            let verdict = check == Some(Check::Running) && srv.check != Some(Check::Running);
+            let passed = verdict && srv.check == Some(Check::Passed);
+            check = srv.check;
+            let waiting = matches!(srv.activity, Activity::Checking { .. });
+            if verdict && !passed {
+                // A failed check: its start applied nothing.
+                commands = now;
+            }
+            if !waiting && (passed || now != commands) {
                 commands = now;
                 let a = Applied::of(sim.rig().server(), sim.seconds());
                 serde_json::to_writer(&mut *w, &a)?;

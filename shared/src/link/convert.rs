@@ -1,12 +1,20 @@
 //! Between the rig's types and their wire images: modes, faults, refusals, the configuration,
 //! and the I16F16 / degree conversions at the boundary.
 
-use super::message::{Fault, Mode, RMethod, StopReason, WireConfig, WireGeometry, Q16};
+use super::message::{
+    Fault, Mode, RMethod, SensorDiagnostics, StopReason, WireCalibration, WireClosedLoop,
+    WireConfig, WireGeometry, Q16,
+};
 use super::reason::{ConfigField, Reason};
 use crate::model::{self, Geometry};
+use crate::rig::as5047::Diagnostics;
+use crate::rig::calibration::Calibration;
+use crate::rig::closed_loop::ClosedLoopR;
 use crate::rig::config::{Limits, MotorConfig, RigConfig};
+use crate::rig::estimator::Tuning;
 use crate::rig::fixed::Angle;
 use crate::rig::safety;
+use crate::rig::servo::ServoMap;
 use crate::ParamError;
 
 /// A number as I16F16 bits, saturating at the ends of the range; NaN gives 0.
@@ -41,6 +49,7 @@ impl From<safety::Fault> for Fault {
             safety::Fault::WrongDirection => Self::WrongDirection,
             safety::Fault::PhaseLockLost => Self::PhaseLockLost,
             safety::Fault::OverCurrentRms => Self::OverCurrentRms,
+            safety::Fault::DutyCeiling => Self::DutyCeiling,
         }
     }
 }
@@ -147,6 +156,7 @@ impl From<RigConfig> for WireConfig {
                     stall_fraction,
                     stall_ms,
                     link_timeout_ms,
+                    duty_max,
                 },
             motor:
                 MotorConfig {
@@ -158,6 +168,8 @@ impl From<RigConfig> for WireConfig {
                 },
             sample_hz,
             control_hz,
+            calibration,
+            closed_loop,
         } = c;
         Self {
             amplitude,
@@ -181,6 +193,9 @@ impl From<RigConfig> for WireConfig {
             max_correction,
             sample_hz,
             control_hz,
+            duty_max,
+            calibration: calibration.into(),
+            closed_loop: closed_loop.into(),
         }
     }
 }
@@ -209,6 +224,9 @@ impl From<WireConfig> for RigConfig {
             max_correction,
             sample_hz,
             control_hz,
+            duty_max,
+            calibration,
+            closed_loop,
         } = w;
         Self {
             amplitude,
@@ -226,6 +244,7 @@ impl From<WireConfig> for RigConfig {
                 stall_fraction,
                 stall_ms,
                 link_timeout_ms,
+                duty_max,
             },
             motor: MotorConfig {
                 omega_per_duty,
@@ -236,6 +255,134 @@ impl From<WireConfig> for RigConfig {
             },
             sample_hz,
             control_hz,
+            calibration: calibration.into(),
+            closed_loop: closed_loop.into(),
+        }
+    }
+}
+
+impl From<Calibration> for WireCalibration {
+    fn from(c: Calibration) -> Self {
+        let Calibration {
+            pendulum_zero,
+            pendulum_sign,
+            crank_sign,
+            servo:
+                ServoMap {
+                    min_us,
+                    max_us,
+                    range_deg,
+                    centre_deg,
+                },
+            current_offset,
+            current_scale,
+            estimator:
+                Tuning {
+                    hysteresis,
+                    min_swing,
+                    settle_band,
+                    block_s,
+                    quiet_blocks,
+                },
+        } = c;
+        Self {
+            pendulum_zero,
+            pendulum_sign,
+            crank_sign,
+            servo_min_us: min_us,
+            servo_max_us: max_us,
+            servo_range_deg: range_deg,
+            servo_centre_deg: centre_deg,
+            current_offset,
+            current_scale,
+            hysteresis,
+            min_swing,
+            settle_band,
+            block_s,
+            quiet_blocks,
+        }
+    }
+}
+
+impl From<WireCalibration> for Calibration {
+    fn from(w: WireCalibration) -> Self {
+        let WireCalibration {
+            pendulum_zero,
+            pendulum_sign,
+            crank_sign,
+            servo_min_us,
+            servo_max_us,
+            servo_range_deg,
+            servo_centre_deg,
+            current_offset,
+            current_scale,
+            hysteresis,
+            min_swing,
+            settle_band,
+            block_s,
+            quiet_blocks,
+        } = w;
+        Self {
+            pendulum_zero,
+            pendulum_sign,
+            crank_sign,
+            servo: ServoMap {
+                min_us: servo_min_us,
+                max_us: servo_max_us,
+                range_deg: servo_range_deg,
+                centre_deg: servo_centre_deg,
+            },
+            current_offset,
+            current_scale,
+            estimator: Tuning {
+                hysteresis,
+                min_swing,
+                settle_band,
+                block_s,
+                quiet_blocks,
+            },
+        }
+    }
+}
+
+impl From<ClosedLoopR> for WireClosedLoop {
+    fn from(c: ClosedLoopR) -> Self {
+        let ClosedLoopR {
+            enabled,
+            band,
+            rate_max,
+        } = c;
+        Self {
+            enabled,
+            band,
+            rate_max,
+        }
+    }
+}
+
+impl From<WireClosedLoop> for ClosedLoopR {
+    fn from(w: WireClosedLoop) -> Self {
+        let WireClosedLoop {
+            enabled,
+            band,
+            rate_max,
+        } = w;
+        Self {
+            enabled,
+            band,
+            rate_max,
+        }
+    }
+}
+
+impl From<Diagnostics> for SensorDiagnostics {
+    fn from(d: Diagnostics) -> Self {
+        Self {
+            agc: d.agc,
+            magnet_low: d.magnet_low,
+            magnet_high: d.magnet_high,
+            cordic_overflow: d.cordic_overflow,
+            ready: d.ready,
         }
     }
 }

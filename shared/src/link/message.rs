@@ -32,6 +32,8 @@ pub type Turns = i32;
 pub type Q15 = i16;
 
 /// From the laptop to the rig.
+// No heap on the rig: the configuration travels inline, and a request is built once.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, MaxSize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Request {
@@ -61,11 +63,18 @@ pub enum Request {
     /// Stream [`Response::Telemetry`] every `period_ms` (0 stops the stream; the rig may
     /// raise a period shorter than its line can carry).
     Telemetry { period_ms: u16 },
+    /// Bring-up mode (from idle, or to change it): the crank motor at an open-loop `duty`
+    /// no larger than the bring-up cap (`station::bring_up`), the servo jogged to θd (degrees
+    /// along the travel, I16F16, slewed), and [`Response::Raw`] streamed instead of
+    /// [`Response::Telemetry`]. [`Request::Stop`], link silence or a new configuration leaves
+    /// it (duty 0), and so does a start (for its pre-run check); faults stop it as they stop
+    /// the drive.
+    BringUp { duty: Q15, theta_d_deg: Q16 },
 }
 
 impl Request {
     /// How many kinds of request this protocol version has (variant indices 0..KINDS).
-    pub const KINDS: u32 = 8;
+    pub const KINDS: u32 = 9;
 }
 
 /// From the rig to the laptop.
@@ -82,11 +91,13 @@ pub enum Response {
     Config(WireConfig),
     /// Unsolicited, at the period asked for by [`Request::Telemetry`].
     Telemetry(Telemetry),
+    /// Unsolicited in bring-up mode, at the same period: the sensors as they read.
+    Raw(RawTelemetry),
 }
 
 impl Response {
     /// How many kinds of response this protocol version has (variant indices 0..KINDS).
-    pub const KINDS: u32 = 6;
+    pub const KINDS: u32 = 7;
 }
 
 /// Frozen forever: its encoding must never change (golden frame in `tests/link_golden.rs`).
@@ -121,6 +132,82 @@ pub struct Status {
     pub counters: Counters,
     /// Why the rig last reset, and the fault latched before it.
     pub reset: ResetInfo,
+    /// The pre-run check of the last start: running, or its verdict (`None` before any).
+    pub check: Option<Check>,
+    /// In bring-up mode: its open-loop duty (I1F15).
+    pub bring_up: Option<Q15>,
+}
+
+/// The pre-run check that every start from idle runs first (`station::precheck`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Check {
+    /// Running: the drive starts when it passes.
+    Running,
+    /// Passed: the drive started.
+    Passed,
+    /// Failed: the drive did not start, for this reason.
+    Failed(Verdict),
+}
+
+/// Why a pre-run check failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Verdict {
+    /// The pendulum sensor gave no good angle through the check.
+    SensorSilent,
+    /// The sensor answers, but its diagnostics are missing, not ready, or the magnet is out
+    /// of range: what a sensor that is not there, or a line stuck low, looks like.
+    SensorNotReady,
+    /// The current at rest (A, I16F16) is beyond the offset a healthy sense reads.
+    CurrentOffset { amps: Q16 },
+    /// The test pulse turned the crank backwards (crank speed, rad/s, I16F16): encoder
+    /// channels or motor leads swapped.
+    CrankReversed { speed: Q16 },
+    /// The test pulse did not turn the crank (a stalled or unpowered motor).
+    CrankStalled { speed: Q16 },
+    /// The test pulse turned the crank far faster than the motor's gain says.
+    CrankTooFast { speed: Q16 },
+    /// Stopped before its verdict: a stop request, or a fault (the status says which).
+    Aborted,
+}
+
+/// The sensors as they read, for bringing a bench up and for calibration: no estimator, no
+/// calibration applied.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RawTelemetry {
+    /// The rig's clock (µs, wrapping) of the latest pendulum sample.
+    pub t_us: u32,
+    /// The pendulum sensor's count (0..2^14) at that sample; `None` if the read failed.
+    pub pendulum: Option<u16>,
+    /// The crank encoder as wired, before its calibrated sign (2^-32 turn, wrapping).
+    pub crank: u32,
+    /// The current sense's ADC reading (counts).
+    pub current: u16,
+    /// The duty commanded (I1F15).
+    pub duty: Q15,
+    /// The pendulum sensor's last diagnostics read, if any yet.
+    pub diagnostics: Option<SensorDiagnostics>,
+    /// Sensor reads that failed since power-up ([`Counters::sensor_errors`]).
+    pub sensor_errors: u32,
+    /// θd now, degrees along the mount's travel (I16F16).
+    pub theta_d_deg: Q16,
+    /// [`Counters::commands`] when the snapshot was taken.
+    pub commands: u32,
+}
+
+/// The AS5047P's DIAAGC register ([`crate::rig::as5047::Diagnostics`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorDiagnostics {
+    /// Automatic gain control: 0 strongest field, 255 weakest.
+    pub agc: u8,
+    pub magnet_low: bool,
+    pub magnet_high: bool,
+    pub cordic_overflow: bool,
+    /// Offset compensation finished.
+    pub ready: bool,
 }
 
 /// Why the rig last reset (the chip's reset flags), and the last fault latched before it (kept
@@ -213,9 +300,13 @@ pub struct Telemetry {
     pub steady: bool,
     /// [`Counters::commands`] when the snapshot was taken.
     pub commands: u32,
+    /// The fast wobble's amplitude at the drive frequency (rad, I16F16), from the estimator's
+    /// I/Q demodulation over the latest drive period; 0 while the drive is not running.
+    pub wobble: Q16,
 }
 
-/// The supervisor's mode ([`crate::rig::safety::Mode`]).
+/// The supervisor's mode ([`crate::rig::safety::Mode`]), and `Checking` while a start waits
+/// for its pre-run check (the supervisor is idle then).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, MaxSize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Mode {
@@ -224,6 +315,7 @@ pub enum Mode {
     Running,
     Stopping(StopReason),
     Faulted(Fault),
+    Checking,
 }
 
 /// [`crate::rig::safety::StopReason`].
@@ -246,6 +338,7 @@ pub enum Fault {
     WrongDirection,
     PhaseLockLost,
     OverCurrentRms,
+    DutyCeiling,
 }
 
 /// [`crate::model::RMethod`].
@@ -293,4 +386,36 @@ pub struct WireConfig {
     pub max_correction: f64,
     pub sample_hz: u32,
     pub control_hz: u32,
+    pub duty_max: f64,
+    pub calibration: WireCalibration,
+    pub closed_loop: WireClosedLoop,
+}
+
+/// [`crate::rig::calibration::Calibration`], field for field.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WireCalibration {
+    pub pendulum_zero: u16,
+    pub pendulum_sign: i8,
+    pub crank_sign: i8,
+    pub servo_min_us: u32,
+    pub servo_max_us: u32,
+    pub servo_range_deg: f64,
+    pub servo_centre_deg: f64,
+    pub current_offset: f64,
+    pub current_scale: f64,
+    pub hysteresis: f64,
+    pub min_swing: f64,
+    pub settle_band: f64,
+    pub block_s: f64,
+    pub quiet_blocks: u32,
+}
+
+/// [`crate::rig::closed_loop::ClosedLoopR`], field for field.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WireClosedLoop {
+    pub enabled: bool,
+    pub band: f64,
+    pub rate_max: f64,
 }

@@ -16,7 +16,7 @@ use core::fmt;
 use postcard::experimental::max_size::MaxSize;
 use serde::{Deserialize, Serialize};
 
-use super::message::{Fault, Mode, Q16};
+use super::message::{Fault, Mode, Q15, Q16};
 
 /// A refusal: the frame was bad or the command was not allowed. Nothing changed on the rig.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
@@ -54,6 +54,10 @@ pub enum Reason {
     EStopStillActive,
     /// A configuration value is out of range.
     ConfigInvalid { field: ConfigField },
+    /// A pre-run check is running: wait for its verdict (in the status).
+    CheckRunning,
+    /// A bring-up duty (I1F15) above the bring-up cap.
+    DutyAboveCap { requested: Q15, cap: Q15 },
 }
 
 /// The configuration field a [`Reason::ConfigInvalid`] names.
@@ -76,6 +80,22 @@ pub enum ConfigField {
     Ki,
     MaxCorrection,
     Rates,
+    DutyMax,
+    PendulumZero,
+    PendulumSign,
+    CrankSign,
+    ServoPulse,
+    ServoRange,
+    ServoCentre,
+    CurrentOffset,
+    CurrentScale,
+    Hysteresis,
+    MinSwing,
+    SettleBand,
+    BlockS,
+    QuietBlocks,
+    ClosedLoopBand,
+    ClosedLoopRateMax,
     Other,
 }
 
@@ -99,6 +119,22 @@ impl ConfigField {
             "ki" => Self::Ki,
             "max_correction" => Self::MaxCorrection,
             "sample_hz" | "control_hz" => Self::Rates,
+            "duty_max" => Self::DutyMax,
+            "pendulum_zero" => Self::PendulumZero,
+            "pendulum_sign" => Self::PendulumSign,
+            "crank_sign" => Self::CrankSign,
+            "servo_pulse_us" => Self::ServoPulse,
+            "servo_range_deg" => Self::ServoRange,
+            "servo_centre_deg" => Self::ServoCentre,
+            "current_offset" => Self::CurrentOffset,
+            "current_scale" => Self::CurrentScale,
+            "hysteresis" => Self::Hysteresis,
+            "min_swing" => Self::MinSwing,
+            "settle_band" => Self::SettleBand,
+            "block_s" => Self::BlockS,
+            "quiet_blocks" => Self::QuietBlocks,
+            "closed_loop_band" => Self::ClosedLoopBand,
+            "closed_loop_rate_max" => Self::ClosedLoopRateMax,
             _ => Self::Other,
         }
     }
@@ -121,6 +157,22 @@ impl ConfigField {
             Self::Ki => "ki",
             Self::MaxCorrection => "max_correction",
             Self::Rates => "sample_hz/control_hz",
+            Self::DutyMax => "duty_max",
+            Self::PendulumZero => "calibration.pendulum_zero",
+            Self::PendulumSign => "calibration.pendulum_sign",
+            Self::CrankSign => "calibration.crank_sign",
+            Self::ServoPulse => "calibration.servo_min_us/servo_max_us",
+            Self::ServoRange => "calibration.servo_range_deg",
+            Self::ServoCentre => "calibration.servo_centre_deg",
+            Self::CurrentOffset => "calibration.current_offset",
+            Self::CurrentScale => "calibration.current_scale",
+            Self::Hysteresis => "calibration.hysteresis",
+            Self::MinSwing => "calibration.min_swing",
+            Self::SettleBand => "calibration.settle_band",
+            Self::BlockS => "calibration.block_s",
+            Self::QuietBlocks => "calibration.quiet_blocks",
+            Self::ClosedLoopBand => "closed_loop.band",
+            Self::ClosedLoopRateMax => "closed_loop.rate_max",
             Self::Other => "a configuration value",
         }
     }
@@ -144,6 +196,8 @@ impl Reason {
             Self::WrongMode(_) => 21,
             Self::EStopStillActive => 22,
             Self::ConfigInvalid { .. } => 23,
+            Self::CheckRunning => 24,
+            Self::DutyAboveCap { .. } => 25,
         }
     }
 
@@ -198,6 +252,46 @@ impl fmt::Display for Reason {
             Self::ConfigInvalid { field } => {
                 write!(f, "configuration value {} out of range", field.name())
             }
+            Self::CheckRunning => f.write_str("the pre-run check is running: wait for its verdict"),
+            Self::DutyAboveCap { requested, cap } => write!(
+                f,
+                "bring-up duty {} is above the bring-up cap {}",
+                f64::from(requested) / 32_768.0,
+                f64::from(cap) / 32_768.0
+            ),
+        }
+    }
+}
+
+impl fmt::Display for super::message::Verdict {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use super::message::Verdict as V;
+        match *self {
+            V::SensorSilent => f.write_str("the pendulum sensor gave no angle during the check"),
+            V::SensorNotReady => f.write_str(
+                "the pendulum sensor is not ready (no diagnostics, or its magnet out of range)",
+            ),
+            V::CurrentOffset { amps } => write!(
+                f,
+                "the current sense reads {:.3} A at rest (calibrate its offset)",
+                q16(amps)
+            ),
+            V::CrankReversed { speed } => write!(
+                f,
+                "the test pulse turned the crank backwards ({:.1} rad/s): encoder channels or motor leads swapped (calibration.crank_sign)",
+                q16(speed)
+            ),
+            V::CrankStalled { speed } => write!(
+                f,
+                "the test pulse did not turn the crank ({:.1} rad/s): motor stalled or unpowered",
+                q16(speed)
+            ),
+            V::CrankTooFast { speed } => write!(
+                f,
+                "the test pulse turned the crank too fast ({:.1} rad/s) for the motor's configured gain",
+                q16(speed)
+            ),
+            V::Aborted => f.write_str("the check was stopped before its verdict"),
         }
     }
 }

@@ -3,16 +3,18 @@
 //! request. [`crate::station::RigLoop`] owns one and frames its answers.
 
 use super::convert::{deg_along_travel, from_q16, to_q16};
+use super::message::Verdict;
 use super::message::{
-    Counters, Request, ResetInfo, Response, Status, Telemetry, VersionInfo, WireConfig,
+    Check, Counters, Mode, Request, ResetInfo, Response, Status, Telemetry, VersionInfo, WireConfig,
 };
 use super::reason::Reason;
 use crate::persist::ConfigOrigin;
 use crate::rig::config::RigConfig;
 use crate::rig::controller::{ControlReport, Rig};
 use crate::rig::dds::omega_of_word;
-use crate::rig::fixed::{Amps, Angle};
+use crate::rig::fixed::{Amps, Angle, Duty};
 use crate::rig::safety::{self, Request as Sr};
+use crate::station::precheck::PreCheck;
 
 /// A request that changes the drive. Everything else ([`Request::GetVersion`],
 /// [`Request::GetStatus`], …) is answered without touching the rig.
@@ -113,10 +115,34 @@ pub fn status(
         uptime_ms,
         counters,
         reset,
+        check: None,
+        bring_up: None,
     }
 }
 
+/// What the rig does besides what its supervisor says: a start waiting for its pre-run check,
+/// or bring-up mode. The supervisor is idle in both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Activity {
+    None,
+    /// The pre-run check runs; `start` is carried out when it passes.
+    Checking {
+        check: PreCheck,
+        start: Command,
+    },
+    /// Bring-up mode at this open-loop duty.
+    BringUp {
+        duty: Duty,
+    },
+}
+
+/// The largest |duty| bring-up mode accepts (also capped at `duty_max`): a quarter of full
+/// speed turns a crank visibly and slowly enough to stop by hand.
+pub const BRING_UP_DUTY_MAX: f64 = 0.25;
+
 /// What the caller must do besides sending the response.
+// No heap on the rig: the configuration travels inline, once per request.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Effect {
     None,
@@ -162,7 +188,12 @@ pub struct RigServer {
     pub cfg: RigConfig,
     pub origin: ConfigOrigin,
     pub counters: Counters,
-    pub tuning: crate::rig::estimator::Tuning,
+    /// A start waiting for its check, or bring-up mode.
+    pub activity: Activity,
+    /// The last pre-run check: running, or its verdict.
+    pub check: Option<Check>,
+    /// The link's clock when a valid request last arrived (bring-up leaves on silence).
+    pub heard_us: u32,
     /// This firmware's version, reported by `GetVersion`.
     pub firmware: [u16; 3],
     /// The protocol version reported by `GetVersion`: [`super::PROTOCOL_VERSION`] unless a
@@ -177,19 +208,20 @@ impl RigServer {
     pub fn new(
         cfg: RigConfig,
         origin: ConfigOrigin,
-        tuning: crate::rig::estimator::Tuning,
         theta_d0: Angle,
         at: Clock,
         firmware: [u16; 3],
     ) -> Self {
-        let mut rig = Rig::new(&cfg, &tuning, theta_d0, at.rig_us);
+        let mut rig = Rig::new(&cfg, &cfg.calibration.estimator, theta_d0, at.rig_us);
         rig.link_message(at.link_us);
         Self {
             rig,
             cfg,
             origin,
             counters: Counters::default(),
-            tuning,
+            activity: Activity::None,
+            check: None,
+            heard_us: at.link_us,
             firmware,
             protocol: super::PROTOCOL_VERSION,
             reset: ResetInfo::POWER_ON,
@@ -200,6 +232,7 @@ impl RigServer {
     /// alive). `estop` is the e-stop line now.
     pub fn respond(&mut self, req: Request, at: Clock, estop: bool) -> (Response, Effect) {
         self.rig.link_message(at.link_us);
+        self.heard_us = at.link_us;
         let (resp, effect) = match req {
             Request::GetVersion => (
                 Response::Version(VersionInfo {
@@ -209,20 +242,12 @@ impl RigServer {
                 Effect::None,
             ),
             Request::GetStatus => (
-                Response::Status(status(
-                    &self.rig,
-                    &self.cfg,
-                    estop,
-                    self.origin,
-                    at.uptime_ms,
-                    self.counters,
-                    self.reset,
-                )),
+                Response::Status(self.status(estop, at.uptime_ms)),
                 Effect::None,
             ),
             Request::SetDrive { .. } | Request::Stop | Request::ClearFault => {
                 let r = match Command::of(&req) {
-                    Some(c) => apply(&mut self.rig, &self.cfg, c),
+                    Some(c) => self.command(c),
                     None => Err(Reason::UnknownMessage),
                 };
                 match r {
@@ -230,6 +255,10 @@ impl RigServer {
                     Err(reason) => (Response::Refused(reason), Effect::None),
                 }
             }
+            Request::BringUp { duty, theta_d_deg } => match self.bring_up(duty, theta_d_deg) {
+                Ok(()) => (Response::Ok, Effect::None),
+                Err(reason) => (Response::Refused(reason), Effect::None),
+            },
             Request::SetConfig(w) => match self.set_config(w, at) {
                 Ok(Some(cfg)) => (Response::Ok, Effect::StoreConfig(cfg)),
                 Ok(None) => (Response::Ok, Effect::None),
@@ -240,12 +269,97 @@ impl RigServer {
         };
         let command = matches!(
             req,
-            Request::SetDrive { .. } | Request::Stop | Request::ClearFault | Request::SetConfig(_)
+            Request::SetDrive { .. }
+                | Request::Stop
+                | Request::ClearFault
+                | Request::SetConfig(_)
+                | Request::BringUp { .. }
         );
         if command && resp == Response::Ok {
             self.counters.commands = self.counters.commands.wrapping_add(1);
         }
         (resp, effect)
+    }
+
+    /// The status message now.
+    pub fn status(&self, estop: bool, uptime_ms: u32) -> Status {
+        let mut s = status(
+            &self.rig,
+            &self.cfg,
+            estop,
+            self.origin,
+            uptime_ms,
+            self.counters,
+            self.reset,
+        );
+        s.check = self.check;
+        if let Activity::Checking { .. } = self.activity {
+            s.mode = Mode::Checking;
+        }
+        s.bring_up = match self.activity {
+            Activity::BringUp { duty } => Some(duty.to_bits()),
+            _ => None,
+        };
+        s
+    }
+
+    /// A drive command. A start from idle is checked now (all or nothing, as [`apply`]) but
+    /// carried out only once its pre-run check passes; a stop ends a check or bring-up.
+    fn command(&mut self, cmd: Command) -> Result<(), Reason> {
+        if let Activity::Checking { .. } = self.activity {
+            if cmd == Command::Stop {
+                self.activity = Activity::None;
+                self.check = Some(Check::Failed(Verdict::Aborted));
+                return Ok(());
+            }
+            return Err(Reason::CheckRunning);
+        }
+        let starts = matches!(cmd, Command::SetDrive { r, .. } if r > 0)
+            && self.rig.supervisor().mode() == safety::Mode::Idle;
+        if !starts {
+            apply(&mut self.rig, &self.cfg, cmd)?;
+            if cmd == Command::Stop {
+                self.activity = Activity::None;
+            }
+            return Ok(());
+        }
+        let mut trial = self.rig;
+        apply(&mut trial, &self.cfg, cmd)?;
+        self.activity = Activity::Checking {
+            check: PreCheck::new(&self.cfg),
+            start: cmd,
+        };
+        self.check = Some(Check::Running);
+        Ok(())
+    }
+
+    /// Enters bring-up mode, or changes its duty and θd; only from idle.
+    fn bring_up(&mut self, duty: i16, theta_d_deg: i32) -> Result<(), Reason> {
+        if let Activity::Checking { .. } = self.activity {
+            return Err(Reason::CheckRunning);
+        }
+        let cap = BRING_UP_DUTY_MAX.min(self.cfg.limits.duty_max);
+        let cap_bits = libm::round(cap * 32_768.0) as i16;
+        if duty.unsigned_abs() > cap_bits.unsigned_abs() {
+            return Err(Reason::DutyAboveCap {
+                requested: duty,
+                cap: cap_bits,
+            });
+        }
+        match self.rig.supervisor().mode() {
+            safety::Mode::Idle => {}
+            safety::Mode::Faulted(f) => return Err(Reason::Faulted(f.into())),
+            m => return Err(Reason::WrongMode(m.into())),
+        }
+        let mut trial = self.rig;
+        trial.request(Sr::SetDriveAngle {
+            deg: from_q16(theta_d_deg),
+        })?;
+        self.rig = trial;
+        self.activity = Activity::BringUp {
+            duty: Duty::from_bits(duty),
+        };
+        Ok(())
     }
 
     /// A new configuration: valid, and the rig idle; the rig restarts on it with θd kept.
@@ -261,8 +375,13 @@ impl RigServer {
             return Ok(None);
         }
         config_change_allowed(&self.rig)?;
+        match self.activity {
+            Activity::Checking { .. } => return Err(Reason::CheckRunning),
+            Activity::BringUp { .. } => self.activity = Activity::None,
+            Activity::None => {}
+        }
         let theta_d = self.rig.supervisor().theta_d();
-        self.rig = Rig::new(&cfg, &self.tuning, theta_d, at.rig_us);
+        self.rig = Rig::new(&cfg, &cfg.calibration.estimator, theta_d, at.rig_us);
         self.rig.link_message(at.link_us);
         self.cfg = cfg;
         self.origin = ConfigOrigin::Received { saved: false };
@@ -280,9 +399,13 @@ impl RigServer {
     ) -> Telemetry {
         let (rig, cfg) = (&self.rig, &self.cfg);
         let e = rig.estimate();
+        let mode = match self.activity {
+            Activity::Checking { .. } => Mode::Checking,
+            _ => report.mode.into(),
+        };
         Telemetry {
             t_us,
-            mode: report.mode.into(),
+            mode,
             theta: theta.to_bits(),
             phi: e.phi.to_bits(),
             phi_rate: e.phi_rate.to_bits(),
@@ -303,6 +426,13 @@ impl RigServer {
             )),
             steady: report.steady,
             commands: self.counters.commands,
+            wobble: match report.mode {
+                safety::Mode::Running | safety::Mode::Stopping(_) => {
+                    // Q30 rad → Q16 rad
+                    rig.wobble().to_bits() >> 14
+                }
+                _ => 0,
+            },
         }
     }
 

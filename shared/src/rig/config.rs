@@ -9,6 +9,8 @@
 //! A: amplitude of the pivot's motion, half its peak-to-peak stroke (the crank radius)
 //! ```
 
+use super::calibration::Calibration;
+use super::closed_loop::ClosedLoopR;
 use super::fixed::{Angle, RadPerSec};
 use crate::error::{positive, ParamError};
 use crate::model::groups::omega_for_r;
@@ -36,6 +38,9 @@ pub struct Limits {
     pub stall_ms: u32,
     /// The laptop link is silent after this long without a valid message (ms).
     pub link_timeout_ms: u32,
+    /// The largest |duty| the drive may command, in (0, 1]: the phase lock is clamped to it,
+    /// and a drive that needs it for `stall_ms` is stopped (`Fault::DutyCeiling`).
+    pub duty_max: f64,
 }
 
 /// The crank motor as the phase lock sees it.
@@ -65,6 +70,11 @@ pub struct RigConfig {
     /// must be a multiple of the control rate.
     pub sample_hz: u32,
     pub control_hz: u32,
+    /// The bench's measured constants (sensor zero and signs, servo map, current sense,
+    /// estimator thresholds).
+    pub calibration: Calibration,
+    /// Closing the loop on R (off by default).
+    pub closed_loop: ClosedLoopR,
 }
 
 /// Fixed-point constants derived from a validated configuration.
@@ -101,6 +111,7 @@ impl RigConfig {
             stall_fraction: 0.3,
             stall_ms: 300,
             link_timeout_ms: 1000,
+            duty_max: 1.0,
         },
         motor: MotorConfig {
             omega_per_duty: 500.0,
@@ -111,6 +122,8 @@ impl RigConfig {
         },
         sample_hz: 10_000,
         control_hz: 1_000,
+        calibration: Calibration::DEFAULT,
+        closed_loop: ClosedLoopR::DEFAULT,
     };
 
     /// Checks every number once; the rest of the rig logic relies on it.
@@ -187,6 +200,9 @@ impl RigConfig {
                 "finite, above drive_angle_min_deg, and less than a turn from it",
             ));
         }
+        if !(l.duty_max.is_finite() && l.duty_max > 0.0 && l.duty_max <= 1.0) {
+            return Err(too_big("duty_max", l.duty_max, "a fraction in (0, 1]"));
+        }
         // The duty conversion multiplies by 2^30/omega_per_duty in i64: at least 1 rad/s keeps
         // the product below 2^61.
         if positive("omega_per_duty", self.motor.omega_per_duty)? < 1.0 {
@@ -212,6 +228,8 @@ impl RigConfig {
                 "a multiple of control_hz, from 1 kHz to 12 kHz (the firmware's sample budget)",
             ));
         }
+        self.calibration.validate()?;
+        self.closed_loop.validate()?;
         Ok(self)
     }
 
@@ -270,7 +288,8 @@ fn q16(name: &'static str, value: f64) -> Result<f64, ParamError> {
     }
 }
 
-fn too_big(name: &'static str, value: f64, allowed: &'static str) -> ParamError {
+/// A refusal of `name` = `value`, saying what is allowed.
+pub(crate) fn too_big(name: &'static str, value: f64, allowed: &'static str) -> ParamError {
     ParamError {
         name,
         value,
@@ -318,6 +337,17 @@ mod tests {
         let mut c = RigConfig::REFERENCE;
         c.limits.drive_angle_min_deg = 200.0;
         assert_eq!(c.validate().unwrap_err().name, "drive_angle_max_deg");
+        for d in [0.0, -0.5, 1.01, f64::NAN] {
+            let mut c = RigConfig::REFERENCE;
+            c.limits.duty_max = d;
+            assert_eq!(c.validate().unwrap_err().name, "duty_max", "{d}");
+        }
+        let mut c = RigConfig::REFERENCE;
+        c.calibration.crank_sign = 0;
+        assert_eq!(c.validate().unwrap_err().name, "crank_sign");
+        let mut c = RigConfig::REFERENCE;
+        c.closed_loop.rate_max = 0.0;
+        assert_eq!(c.validate().unwrap_err().name, "closed_loop_rate_max");
         assert!(RigConfig::REFERENCE.omega_for_r(-1.0).is_err());
     }
 }

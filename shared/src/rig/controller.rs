@@ -15,7 +15,8 @@ use super::dds::Dds;
 use super::estimator::{Estimate, Estimator, Tuning};
 use super::fixed::{Angle, Duty, RadPerSec};
 use super::phase_lock::{LockOutput, Motor, PhaseLock};
-use super::r_trim::{RTrim, Settings};
+use super::closed_loop::ClosedLoopR;
+use super::r_trim::RTrim;
 use super::safety::{Inputs, Mode, Refusal, Request, Supervisor};
 
 /// What one control tick did.
@@ -42,6 +43,7 @@ pub struct Rig {
     sup: Supervisor,
     sensor_failed: bool,
     phase_error: RadPerSec,
+    saturated: bool,
     trim: RTrim,
 }
 
@@ -56,12 +58,9 @@ impl Rig {
             sup: Supervisor::new(cfg, theta_d0, now_us),
             sensor_failed: false,
             phase_error: RadPerSec::ZERO,
+            saturated: false,
             trim: RTrim::new(
-                Settings {
-                    enabled: false,
-                    band: 0.05,
-                    rate_max: 0.1,
-                },
+                cfg.closed_loop,
                 cfg.omega_for_r(1.0).unwrap_or(f64::INFINITY),
                 cfg.limits.omega_max,
             ),
@@ -87,7 +86,7 @@ impl Rig {
 
     /// Closed-loop R on or off (band, rate); off returns ω to the open-loop ω of the R asked
     /// for. `now_us` on the rig's clock.
-    pub fn set_closed_loop(&mut self, settings: Settings, now_us: u32) {
+    pub fn set_closed_loop(&mut self, settings: ClosedLoopR, now_us: u32) {
         if let Some(omega) = self.trim.set(settings, now_us) {
             // The open-loop ω of an accepted R is within the limits: the request cannot fail.
             let _ = self.sup.request(Request::SetOmega { omega });
@@ -135,6 +134,7 @@ impl Rig {
             drive_stopped: self.dds.is_stopped(),
             sensor_failed: self.sensor_failed,
             phase_error: self.phase_error,
+            duty_saturated: self.saturated,
             ramping: self.dds.is_ramping(),
             link_us,
         };
@@ -156,6 +156,7 @@ impl Rig {
         );
         motor.set_duty(lock.duty);
         self.phase_error = lock.error;
+        self.saturated = lock.saturated;
         let steady = run
             && !self.dds.is_ramping()
             && self.dds.word() > 0
@@ -186,6 +187,10 @@ impl Rig {
 
     pub fn estimate(&self) -> &Estimate {
         self.est.estimate()
+    }
+    /// The fast wobble's amplitude over the latest drive period (rad, Q30).
+    pub fn wobble(&self) -> super::fixed::Unit {
+        self.est.wobble_now()
     }
     pub fn dds(&self) -> &Dds {
         &self.dds

@@ -9,6 +9,8 @@
 //! |---|---|
 //! | [`fixed`] | Q-format aliases, the wrapping [`fixed::Angle`], and every approximation (sin/cos, ln, sqrt, division) with its tested error bound |
 //! | [`config`] | the rig configuration — stroke A, pendulum geometry, limits — as one type; R ↔ ω |
+//! | [`calibration`] | the bench's measured constants in the configuration: sensor zero and signs, servo map, current sense, estimator thresholds |
+//! | [`closed_loop`] | the settings of closing the loop on R (carried and stored) |
 //! | [`dds`] | the drive-phase accumulator: exact integer phase, rate-limited phase-continuous frequency changes, soft start and stop |
 //! | [`phase_lock`] | the [`phase_lock::Motor`] trait and the crank phase-lock controller (feed-forward + PI on the phase error) |
 //! | [`estimator`] | slow angle by synchronous averaging, slow frequency and decay, settled flag, R in situ, fast-wobble check of A |
@@ -33,6 +35,8 @@
 //! Costs per update and the 20 % budget at 170 MHz are measured in `docs/accuracy-mcu.md`.
 
 pub mod as5047;
+pub mod calibration;
+pub mod closed_loop;
 pub mod config;
 pub mod controller;
 pub mod dds;

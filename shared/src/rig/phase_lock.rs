@@ -8,7 +8,7 @@
 //! e      = wrap(φ_ref − φ_crank)                       phase error, rad, in (−π, π]
 //! ∫e    += e / fc                                       clamped so |ki·∫e| ≤ c_max (anti-windup)
 //! ω_cmd  = ω_ref + τ·α_ref  +  clamp(kp·e + ki·∫e, ±c_max)
-//! duty   = clamp(ω_cmd / ω_full, [−1, 1))
+//! duty   = clamp(ω_cmd / ω_full, ±duty_max)              (duty_max ≤ 1: the configured ceiling)
 //! ```
 //! Feed-forward ω_ref + τ·α_ref does nearly all the work (τ: the motor's speed lag, so a ramp is
 //! led by τ·dω/dt); the PI on the phase error removes what it misses (gain error, load, friction).
@@ -44,6 +44,8 @@ pub struct PhaseLock {
     /// 1/ω_full in Q30 (s/rad).
     inv_full_q30: i64,
     fc: u32,
+    /// The duty ceiling in I1F15 bits.
+    duty_max: i64,
     /// ∫e dt in rad·s, I16F16.
     integral: RadPerSec,
     last_crank: Option<Angle>,
@@ -61,6 +63,8 @@ pub struct LockOutput {
     pub crank_speed: RadPerSec,
     /// The commanded speed before the duty conversion (rad/s).
     pub omega_cmd: RadPerSec,
+    /// The duty is clamped at the ceiling.
+    pub saturated: bool,
 }
 
 impl PhaseLock {
@@ -73,6 +77,7 @@ impl PhaseLock {
             max_corr: RadPerSec::saturating_from_num(m.max_correction),
             inv_full_q30: libm::round((1u64 << 30) as f64 / m.omega_per_duty) as i64,
             fc: cfg.control_hz.max(1),
+            duty_max: (libm::round(cfg.limits.duty_max * 32_768.0) as i64).clamp(1, 32_767),
             integral: RadPerSec::ZERO,
             last_crank: None,
             crank_speed: RadPerSec::ZERO,
@@ -117,6 +122,7 @@ impl PhaseLock {
                 error: RadPerSec::ZERO,
                 crank_speed: self.crank_speed,
                 omega_cmd: RadPerSec::ZERO,
+                saturated: false,
             };
         }
         let e = RadPerSec::from_bits((ref_phase - crank).to_rad_q().to_bits() >> 12);
@@ -134,12 +140,13 @@ impl PhaseLock {
         let omega_cmd = ff.saturating_add(corr);
         // duty (Q15) = ω_cmd (Q16) · 1/ω_full (Q30) >> 31
         let d = (i64::from(omega_cmd.to_bits()) * self.inv_full_q30) >> 31;
-        let duty = Duty::from_bits(d.clamp(-32_768, 32_767) as i16);
+        let duty = Duty::from_bits(d.clamp(-self.duty_max, self.duty_max) as i16);
         LockOutput {
             duty,
             error: e,
             crank_speed: self.crank_speed,
             omega_cmd,
+            saturated: d.abs() >= self.duty_max,
         }
     }
 
@@ -173,6 +180,26 @@ mod tests {
         // Inactive: zero duty, integrator reset.
         let out = pl.update(false, Angle::ZERO, w, RadPerSec::ZERO, Angle::ZERO);
         assert_eq!(out.duty, Duty::ZERO);
+    }
+
+    #[test]
+    fn the_duty_is_clamped_at_the_configured_ceiling() {
+        // Feed-forward alone at ω = 400 rad/s asks for 400/500 = 0.8 of full duty.
+        let w = RadPerSec::from_num(400);
+        let mut pl = PhaseLock::new(&RigConfig::REFERENCE);
+        let out = pl.update(true, Angle::ZERO, w, RadPerSec::ZERO, Angle::ZERO);
+        assert!((out.duty.to_num::<f64>() - 0.8).abs() < 1e-4);
+        assert!(!out.saturated);
+        // With a ceiling of 0.5: clamped to 0.5 (16384 in I1F15), and said so.
+        let mut cfg = RigConfig::REFERENCE;
+        cfg.limits.duty_max = 0.5;
+        let mut pl = PhaseLock::new(&cfg);
+        let out = pl.update(true, Angle::ZERO, w, RadPerSec::ZERO, Angle::ZERO);
+        assert_eq!(out.duty.to_bits(), 16_384);
+        assert!(out.saturated);
+        // Backwards too.
+        let out = pl.update(true, Angle::ZERO, -w, RadPerSec::ZERO, Angle::ZERO);
+        assert_eq!(out.duty.to_bits(), -16_384);
     }
 
     #[test]

@@ -12,7 +12,7 @@
 //!    ▲                               │  SetOmega (ramped), SetDriveAngle (slewed)      (when the
 //!    │ ClearFault (e-stop released)  │                                                  drive is 0)
 //!    └──────────── Faulted ◀─────────┴── e-stop, over-current (peak, RMS), stall, wrong direction,
-//!                                        sensor, phase lock lost (from any state): drive halted
+//!                                        sensor, phase lock lost, duty ceiling (from any state): drive halted
 //!                                        at once, duty 0, latched
 //! ```
 //! A drive strength R from the laptop becomes ω = ωc√R through [`RigConfig::omega_for_r`]
@@ -24,7 +24,8 @@
 //! commanded speed while the crank turns backwards faster than `stall_fraction`·commanded for
 //! `stall_ms`. Sensor: the pendulum sensor's driver reports it failed. Phase lock lost: two
 //! cycle slips within [`SLIP_WINDOW_US`]. Over-current RMS (I²t): the exponential mean of i²
-//! over [`RMS_TAU_S`] above ([`RMS_FRACTION`]·I_max)².
+//! over [`RMS_TAU_S`] above ([`RMS_FRACTION`]·I_max)². Duty ceiling: the phase lock clamped at
+//! `duty_max` for `stall_ms` while driving.
 //!
 //! # When the laptop link goes silent
 //!
@@ -127,6 +128,9 @@ pub enum Fault {
     /// `current_max`: an I²t limit for the winding and the bridge's continuous rating, below
     /// the peak trip.
     OverCurrentRms,
+    /// The drive has needed the duty ceiling (`duty_max`) for `stall_ms`: the motor cannot
+    /// hold the asked-for speed within the duty it may use.
+    DutyCeiling,
 }
 
 /// Two cycle slips within this long lose the lock (µs).
@@ -170,6 +174,8 @@ pub struct Inputs {
     /// The drive generator is ramping ω: the crank's lag behind the feed-forward may slip
     /// cycles then without the lock being lost (the stall check watches that phase).
     pub ramping: bool,
+    /// The phase lock's duty is clamped at the ceiling `duty_max`.
+    pub duty_saturated: bool,
     /// The link's clock now (µs, wrapping), the clock [`Supervisor::heard_from_link`] is given.
     /// On the rig it is `now_us`; a simulated rig running faster than real time gives wall time,
     /// so the link-silence timeout stays what it says.
@@ -201,6 +207,7 @@ pub struct Supervisor {
     over_since: Option<u32>,
     stall_since: Option<u32>,
     reverse_since: Option<u32>,
+    ceiling_since: Option<u32>,
     last_phase_error: RadPerSec,
     last_slip_us: Option<u32>,
     /// Exponential mean of i² (A²) and its per-tick weight h/τ.
@@ -239,6 +246,7 @@ impl Supervisor {
             over_since: None,
             stall_since: None,
             reverse_since: None,
+            ceiling_since: None,
             last_phase_error: RadPerSec::ZERO,
             last_slip_us: None,
             i2_mean: 0.0,
@@ -316,6 +324,7 @@ impl Supervisor {
                 self.target_word = w;
                 self.stall_since = None;
                 self.reverse_since = None;
+                self.ceiling_since = None;
                 self.last_slip_us = None;
             }
             Request::SetOmega { omega } => {
@@ -350,6 +359,7 @@ impl Supervisor {
                     self.over_since = None;
                     self.stall_since = None;
                     self.reverse_since = None;
+                    self.ceiling_since = None;
                 }
             }
         }
@@ -409,6 +419,14 @@ impl Supervisor {
             self.stall_us,
         ) {
             self.fault(Fault::WrongDirection);
+        }
+        if held(
+            &mut self.ceiling_since,
+            driving && inp.duty_saturated,
+            now_us,
+            self.stall_us,
+        ) {
+            self.fault(Fault::DutyCeiling);
         }
         // A cycle slip: the wrapped phase error jumps from beyond +π/2 to beyond −π/2 or back,
         // with the crank turning the right way at speed (else it is a stall or a wrong

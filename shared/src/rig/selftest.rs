@@ -212,6 +212,7 @@ fn safety_script() -> u64 {
                 drive_stopped: k > 600,
                 sensor_failed: false,
                 phase_error: RadPerSec::ZERO,
+                duty_saturated: false,
                 ramping: false,
                 link_us: t,
             };
@@ -393,6 +394,7 @@ fn bench_faults() -> u64 {
                     (3, 1) => -3.0,
                     _ => 0.0,
                 }),
+                duty_saturated: false,
                 ramping: false,
                 link_us: t,
             };

@@ -24,13 +24,34 @@ pub struct ServoMap {
 }
 
 impl ServoMap {
-    /// The pulse width (µs) that points the mount at `deg`, clamped to the servo's range.
-    pub fn pulse_us(&self, deg: f64) -> u32 {
+    /// The reference board's servo: 500–2500 µs over 270°, centred at θd = 90°.
+    pub const REFERENCE: Self = Self {
+        min_us: 500,
+        max_us: 2500,
+        range_deg: 270.0,
+        centre_deg: 90.0,
+    };
+
+    /// The pulse width (µs, unrounded) that points the mount at `deg`, clamped to the servo's
+    /// range.
+    pub fn pulse(&self, deg: f64) -> f64 {
         let (lo, hi) = (f64::from(self.min_us), f64::from(self.max_us));
         let us = (lo + hi) / 2.0 + (deg - self.centre_deg) * (hi - lo) / self.range_deg;
         // NaN clamps to nothing: send the centre instead.
         let us = if us.is_nan() { (lo + hi) / 2.0 } else { us };
-        libm::round(us.clamp(lo, hi)) as u32
+        us.clamp(lo, hi)
+    }
+
+    /// [`ServoMap::pulse`] rounded to whole µs.
+    pub fn pulse_us(&self, deg: f64) -> u32 {
+        libm::round(self.pulse(deg)) as u32
+    }
+
+    /// The angle (deg) a pulse points the mount at: the inverse of [`ServoMap::pulse`] inside
+    /// the range (a simulated servo's).
+    pub fn deg_of_pulse(&self, us: f64) -> f64 {
+        let (lo, hi) = (f64::from(self.min_us), f64::from(self.max_us));
+        self.centre_deg + (us.clamp(lo, hi) - (lo + hi) / 2.0) * self.range_deg / (hi - lo)
     }
 }
 
@@ -51,12 +72,7 @@ mod tests {
     use super::*;
 
     /// 500–2500 µs over 270°, centred at 90°: 2000 µs / 270° = 7.407 µs per degree.
-    const MAP: ServoMap = ServoMap {
-        min_us: 500,
-        max_us: 2500,
-        range_deg: 270.0,
-        centre_deg: 90.0,
-    };
+    const MAP: ServoMap = ServoMap::REFERENCE;
 
     #[test]
     fn pulse_is_linear_and_clamped() {
@@ -69,6 +85,13 @@ mod tests {
         assert_eq!(MAP.pulse_us(-45.0), 500);
         assert_eq!(MAP.pulse_us(400.0), 2500);
         assert_eq!(MAP.pulse_us(f64::NAN), 1500);
+        // The inverse, inside the range.
+        for deg in [-45.0, 0.0, 37.5, 180.0, 225.0] {
+            assert!(
+                (MAP.deg_of_pulse(MAP.pulse(deg)) - deg).abs() < 1e-12,
+                "{deg}"
+            );
+        }
     }
 
     #[test]

@@ -18,7 +18,11 @@
 //! ```
 //! The true parameters ([`Params`]) may differ from the configuration the rig was given, the
 //! way a real rig differs from what was typed in: the hidden ones (sensor zero and sign, crank
-//! and motor direction, servo offset, current offset) are those calibration must find.
+//! and motor direction, servo offset, current offset) are those calibration must find. The
+//! hardware is the reference board's: the sensor's counts, the crank encoder as wired, the
+//! current sense's ADC counts ([`Calibration::DEFAULT`]'s gain) and the servo's pulse
+//! ([`ServoMap::REFERENCE`]) are produced from the truth and read back through the
+//! *configured* calibration, so a mis-calibrated configuration is visibly off.
 //! Everything is deterministic under [`Params::seed`].
 
 pub mod hand;
@@ -30,14 +34,16 @@ use crate::link::message::Counters;
 use crate::math;
 use crate::model::Geometry;
 use crate::persist::ConfigOrigin;
-use crate::rig::as5047::{self, As5047};
+use crate::rig::as5047::As5047;
+use crate::rig::calibration::Calibration;
 use crate::rig::config::RigConfig;
-use crate::rig::fixed::{Amps, Angle, Duty};
-use crate::rig::phase_lock::Motor;
+use crate::rig::fixed::{Angle, Duty};
+use crate::rig::servo::ServoMap;
 use crate::sim::noise::Noise;
+use crate::station::drive::Drive;
 use crate::station::{RigLoop, Sample};
 use plant::{MotorModel, Plant};
-use sensor::Chip;
+use sensor::{Chip, Line};
 
 /// Crank encoder counts per turn (a power of two, as the firmware's board constant).
 pub const CRANK_COUNTS: u32 = 4096;
@@ -69,6 +75,10 @@ pub struct Params {
     pub servo_offset_deg: f64,
     /// The current sensor's reading at zero current (A).
     pub current_offset: f64,
+    /// The crank is jammed: the motor cannot turn it.
+    pub stalled: bool,
+    /// The pendulum sensor's cable: connected, or cut.
+    pub sensor_line: Line,
     /// The pendulum's angle (rad) at power-up, at rest.
     pub theta0: f64,
     pub seed: u64,
@@ -93,6 +103,8 @@ impl Params {
         servo_rate_deg: 300.0,
         servo_offset_deg: 0.0,
         current_offset: 0.0,
+        stalled: false,
+        sensor_line: Line::Connected,
         theta0: 0.0,
         seed: 1,
     };
@@ -125,8 +137,8 @@ pub struct SimRig {
     pub estop: bool,
     chip: Chip,
     driver: As5047,
-    /// The last good angle (a failed read repeats it, as the firmware does).
-    held: Angle,
+    /// The last good count (a failed read repeats it, as the firmware does).
+    held: u16,
     stats: Stats,
 }
 
@@ -152,7 +164,7 @@ impl SimRig {
             theta_d: math::to_rad(servo0 + params.servo_offset_deg),
             motor: params.motor,
             duty: 0.0,
-            jammed: false,
+            jammed: params.stalled,
         };
         let mut s = Self {
             rig: RigLoop::new(cfg, origin, Angle::from_deg(servo0), 0, firmware),
@@ -165,10 +177,11 @@ impl SimRig {
             estop: false,
             chip: Chip::default(),
             driver: As5047::new(),
-            held: Angle::ZERO,
+            held: 0,
             stats: Stats::default(),
             params,
         };
+        s.chip.line = params.sensor_line;
         // Prime the sensor's pipeline as the firmware does at power-up: the first answer
         // belongs to no command.
         s.chip.angle = s.sensor_code();
@@ -201,14 +214,15 @@ impl SimRig {
         let chip = &mut self.chip;
         let read = self.driver.sample(t_us, |w| Ok::<u16, ()>(chip.frame(w)));
         if let Ok(count) = read.count {
-            self.held = as5047::angle(count, 0, 1);
+            self.held = count;
         }
         let s = Sample {
             t_us: read.t_us,
-            angle: self.held,
+            count: self.held,
             failed: read.count.is_err(),
             late: false,
             sensor_failed: self.driver.health().failed(),
+            diagnostics: self.driver.health().diagnostics,
         };
         if self.rig.sample(s) {
             let mut hw = Hardware {
@@ -223,8 +237,8 @@ impl SimRig {
             if !tick.bridge {
                 self.plant.duty = 0.0;
             }
-            if let Some(deg) = tick.servo_deg {
-                self.servo_target_deg = deg;
+            if let Some(us) = tick.servo_us {
+                self.servo_target_deg = ServoMap::REFERENCE.deg_of_pulse(us);
             }
             if tick.store.is_some() {
                 // The simulated flash always takes the write.
@@ -296,15 +310,18 @@ struct Hardware<'a> {
     current_offset: f64,
 }
 
-impl Motor for Hardware<'_> {
-    fn crank_angle(&mut self) -> Angle {
+impl Drive for Hardware<'_> {
+    fn crank_raw(&mut self) -> Angle {
         let counts = libm::floor(self.crank_sign * self.y[2] / math::TAU * f64::from(CRANK_COUNTS));
         let count = (counts as i64).rem_euclid(i64::from(CRANK_COUNTS)) as u32;
         Angle::from_turns_u32(count * (u32::MAX / CRANK_COUNTS + 1))
     }
-    fn current(&mut self) -> Amps {
-        let i = self.plant.motor.current(self.plant.duty, self.y[3]) + self.current_offset;
-        Amps::saturating_from_num(i)
+    /// The DRV8874's current mirror gives the magnitude; the ADC adds the offset.
+    fn current_counts(&mut self) -> u16 {
+        let i = libm::fabs(self.plant.motor.current(self.plant.duty, self.y[3]));
+        Calibration::DEFAULT
+            .current_sense()
+            .counts(i + self.current_offset)
     }
     fn set_duty(&mut self, duty: Duty) {
         self.plant.duty = duty.to_num();

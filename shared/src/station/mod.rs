@@ -29,21 +29,35 @@
 //! that does not fit is dropped and counted (`Counters::frames_dropped`).
 //!
 //! **An unknown e-stop line counts as pressed**: the rig cannot start blind.
+//!
+//! **The hardware is read raw and calibrated here** ([`drive`]): the pendulum sensor's count,
+//! the crank encoder and the current sense's ADC counts pass through the configuration's
+//! [`crate::rig::calibration::Calibration`], so a calibration set over the link is in use from
+//! the next sample, on the firmware and the simulated rig alike.
+//!
+//! **A start from idle waits for its pre-run check** ([`precheck`]): the status shows it
+//! running, then its verdict; the drive starts only on a pass. **Bring-up mode** drives the
+//! crank open loop at a capped duty and streams the sensors raw ([`Response::Raw`]).
 
+pub mod drive;
+pub mod precheck;
 pub mod selftest;
 
+use crate::link::convert::to_q16;
 use crate::link::frame::{decode_request_as, encode, open, Header};
-use crate::link::message::{Counters, ResetInfo};
-use crate::link::serve::{Clock, Effect, RigServer};
+use crate::link::message::{Check, Counters, RawTelemetry, ResetInfo, Verdict};
+use crate::link::serve::{apply, Activity, Clock, Effect, RigServer};
 use crate::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 use crate::persist::ConfigOrigin;
+use crate::rig::as5047::Diagnostics;
 use crate::rig::config::RigConfig;
 use crate::rig::controller::ControlReport;
-use crate::rig::estimator::Tuning;
 use crate::rig::estop::EStop;
-use crate::rig::fixed::{Amps, Angle};
+use crate::rig::fixed::{elapsed_us, Amps, Angle};
 use crate::rig::phase_lock::Motor;
 use crate::rig::safety::Mode;
+use drive::{Calibrated, Drive};
+use precheck::{SensorView, Step};
 
 /// The shortest telemetry period (ms): a telemetry frame is ≤ 100 bytes, 8.7 ms at 115200 baud.
 pub const MIN_TELEMETRY_MS: u16 = 20;
@@ -52,13 +66,14 @@ pub const MIN_TELEMETRY_MS: u16 = 20;
 const OUTBOX_FRAMES: usize = 4;
 const OUTBOX: usize = OUTBOX_FRAMES * MAX_RESPONSE_FRAME;
 
-/// One pendulum-angle sample.
+/// One pendulum-sensor sample, as read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Sample {
     /// When it was read (µs on the rig's clock, wrapping).
     pub t_us: u32,
-    /// The pendulum angle (the last good one if this read failed).
-    pub angle: Angle,
+    /// The sensor's count, 2^14 a turn (the last good one if this read failed); the rig loop
+    /// turns it into the pendulum angle with the calibration.
+    pub count: u16,
     /// The read failed (bus error, parity, or the sensor's error flag).
     pub failed: bool,
     /// Taken more than half a sample period late.
@@ -66,15 +81,20 @@ pub struct Sample {
     /// The sensor's driver counts the sensor as failed (too many reads in a row without an
     /// angle, or its magnet out of range: [`crate::rig::as5047::Health::failed`]).
     pub sensor_failed: bool,
+    /// The sensor's last diagnostics read, if any yet.
+    pub diagnostics: Option<Diagnostics>,
 }
 
 /// What the caller must do after a control tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tick {
-    /// The H-bridge may be awake: only while the drive runs or ramps down.
+    /// The H-bridge may be awake: only while the drive runs or ramps down, the pre-run
+    /// check pulses, or bring-up mode drives.
     pub bridge: bool,
     /// θd moved: the servo's new position, degrees along the mount's travel.
     pub servo_deg: Option<f64>,
+    /// The same as the servo's pulse width (µs, unrounded), through the calibrated map.
+    pub servo_us: Option<f64>,
     /// A configuration was accepted: write it to flash, then call [`RigLoop::config_saved`].
     /// Its sample rate is in use from the next sample on.
     pub store: Option<RigConfig>,
@@ -148,6 +168,9 @@ pub struct RigLoop {
     last: Sample,
     uptime_us: u64,
     current: Amps,
+    /// The last tick's raw crank reading and ADC counts, for the raw telemetry.
+    raw_crank: Angle,
+    counts: u16,
 }
 
 impl RigLoop {
@@ -160,14 +183,7 @@ impl RigLoop {
         now_us: u32,
         firmware: [u16; 3],
     ) -> Self {
-        let srv = RigServer::new(
-            cfg,
-            origin,
-            Tuning::DEFAULT,
-            theta_d0,
-            Clock::single(now_us, 0),
-            firmware,
-        );
+        let srv = RigServer::new(cfg, origin, theta_d0, Clock::single(now_us, 0), firmware);
         Self {
             samples_per_control: per_control(&cfg),
             srv,
@@ -184,13 +200,16 @@ impl RigLoop {
             store: None,
             last: Sample {
                 t_us: now_us,
-                angle: Angle::ZERO,
+                count: cfg.calibration.pendulum_zero,
                 failed: false,
                 late: false,
                 sensor_failed: false,
+                diagnostics: None,
             },
             uptime_us: 0,
             current: Amps::ZERO,
+            raw_crank: Angle::ZERO,
+            counts: 0,
         }
     }
 
@@ -219,7 +238,11 @@ impl RigLoop {
         self.uptime_us += u64::from(s.t_us.wrapping_sub(self.last.t_us));
         self.last = s;
         self.srv.rig.sensor_failed(s.sensor_failed);
-        self.srv.rig.sample(s.t_us, s.angle);
+        let angle = self.srv.cfg.calibration.pendulum_angle(s.count);
+        self.srv.rig.sample(s.t_us, angle);
+        if let Activity::Checking { check, .. } = &mut self.srv.activity {
+            check.sample(s.failed);
+        }
         self.since_control += 1;
         if self.since_control < self.samples_per_control {
             return false;
@@ -229,17 +252,21 @@ impl RigLoop {
     }
 
     /// The control tick, at the time of the last sample. `link_us` is the link's clock (the
-    /// rig's own on hardware); `estop` the e-stop line as read now, `None` while it is unknown
-    /// (pressed), debounced here ([`crate::rig::estop`]).
-    pub fn control<M: Motor>(&mut self, link_us: u32, motor: &mut M, estop: Option<bool>) -> Tick {
+    /// rig's own on hardware); `drive` the crank motor's hardware, read raw and calibrated
+    /// here; `estop` the e-stop line as read now, `None` while it is unknown (pressed),
+    /// debounced here ([`crate::rig::estop`]).
+    pub fn control<D: Drive>(&mut self, link_us: u32, drive: &mut D, estop: Option<bool>) -> Tick {
         self.estop = self.estop_line.update(estop);
         let t = self.last.t_us;
-        let mut m = Metered {
-            motor,
-            current: self.current,
-        };
-        let report = self.srv.rig.control_at(t, link_us, &mut m, self.estop);
+        let cal = self.srv.cfg.calibration;
+        let mut m = Calibrated::new(drive, &cal);
+        let mut report = self.srv.rig.control_at(t, link_us, &mut m, self.estop);
+        let extra = self.activity(&mut m, &report, link_us);
+        report.duty = m.duty;
+        report.mode = self.srv.rig.supervisor().mode();
         self.current = m.current;
+        self.raw_crank = m.raw_crank;
+        self.counts = m.counts;
         let servo_deg = (self.servo != Some(report.theta_d)).then(|| {
             self.servo = Some(report.theta_d);
             crate::link::convert::deg_along_travel(
@@ -251,18 +278,101 @@ impl RigLoop {
             self.since_telemetry += 1;
             if self.since_telemetry >= self.telemetry_every {
                 self.since_telemetry = 0;
-                let tm = self
-                    .srv
-                    .telemetry(t, &report, self.last.angle, self.current);
+                let resp = if let Activity::BringUp { .. } = self.srv.activity {
+                    Response::Raw(self.raw(&report))
+                } else {
+                    Response::Telemetry(self.srv.telemetry(
+                        t,
+                        &report,
+                        self.srv.cfg.calibration.pendulum_angle(self.last.count),
+                        self.current,
+                    ))
+                };
                 self.telemetry_seq = self.telemetry_seq.wrapping_add(1);
-                self.queue(self.telemetry_seq, &Response::Telemetry(tm), true);
+                self.queue(self.telemetry_seq, &resp, true);
             }
         }
         Tick {
-            bridge: matches!(report.mode, Mode::Running | Mode::Stopping(_)),
+            bridge: matches!(report.mode, Mode::Running | Mode::Stopping(_)) || extra,
             servo_deg,
+            servo_us: servo_deg.map(|d| self.srv.cfg.calibration.servo.pulse(d)),
             store: self.store.take(),
             report,
+        }
+    }
+
+    /// The pre-run check's or bring-up mode's part of a control tick, after the rig's own
+    /// (which left the duty at 0: the supervisor is idle). Returns whether the bridge must be
+    /// awake for it.
+    fn activity<D: Drive>(
+        &mut self,
+        m: &mut Calibrated<'_, D>,
+        report: &ControlReport,
+        link_us: u32,
+    ) -> bool {
+        let idle = report.mode == Mode::Idle;
+        let srv = &mut self.srv;
+        match &mut srv.activity {
+            Activity::None => false,
+            Activity::Checking { .. } if !idle => {
+                srv.activity = Activity::None;
+                srv.check = Some(Check::Failed(Verdict::Aborted));
+                false
+            }
+            Activity::Checking { check, start } => {
+                let sensor = SensorView {
+                    diagnostics: self.last.diagnostics,
+                    failed: self.last.sensor_failed,
+                };
+                let start = *start;
+                match check.tick(m.crank, m.current, sensor) {
+                    Step::Drive { bridge, duty } => {
+                        m.set_duty(duty);
+                        bridge
+                    }
+                    Step::Done(verdict) => {
+                        srv.activity = Activity::None;
+                        srv.check = Some(match verdict {
+                            Ok(()) => match apply(&mut srv.rig, &srv.cfg, start) {
+                                Ok(()) => Check::Passed,
+                                // The start was checked when it arrived and nothing but a
+                                // fault (which aborts above) changes what it needs.
+                                Err(_) => Check::Failed(Verdict::Aborted),
+                            },
+                            Err(v) => Check::Failed(v),
+                        });
+                        false
+                    }
+                }
+            }
+            Activity::BringUp { duty } => {
+                let silent = elapsed_us(srv.heard_us, link_us)
+                    > srv.cfg.limits.link_timeout_ms.saturating_mul(1000);
+                if !idle || silent {
+                    srv.activity = Activity::None;
+                    return false;
+                }
+                m.set_duty(*duty);
+                true
+            }
+        }
+    }
+
+    /// The sensors as they read at this tick.
+    fn raw(&self, report: &ControlReport) -> RawTelemetry {
+        RawTelemetry {
+            t_us: self.last.t_us,
+            pendulum: (!self.last.failed).then_some(self.last.count),
+            crank: self.raw_crank.to_turns_u32(),
+            current: self.counts,
+            duty: report.duty.to_bits(),
+            diagnostics: self.last.diagnostics.map(Into::into),
+            sensor_errors: self.srv.counters.sensor_errors,
+            theta_d_deg: to_q16(crate::link::convert::deg_along_travel(
+                report.theta_d,
+                self.srv.cfg.limits.drive_angle_min_deg,
+            )),
+            commands: self.srv.counters.commands,
         }
     }
 
@@ -377,25 +487,6 @@ impl RigLoop {
             let c = &mut self.srv.counters;
             c.frames_dropped = c.frames_dropped.saturating_add(1);
         }
-    }
-}
-
-/// The motor, with the current it reports kept for the telemetry.
-struct Metered<'a, M> {
-    motor: &'a mut M,
-    current: Amps,
-}
-
-impl<M: Motor> Motor for Metered<'_, M> {
-    fn crank_angle(&mut self) -> Angle {
-        self.motor.crank_angle()
-    }
-    fn current(&mut self) -> Amps {
-        self.current = self.motor.current();
-        self.current
-    }
-    fn set_duty(&mut self, duty: crate::rig::fixed::Duty) {
-        self.motor.set_duty(duty)
     }
 }
 

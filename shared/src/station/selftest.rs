@@ -4,29 +4,30 @@
 //! the target as the simulated rig does on the laptop. The digest and its regeneration are
 //! [`crate::rig::selftest`]'s.
 
+use super::drive::Drive;
 use super::{RigLoop, Sample};
 use crate::link::frame::{encode, Header};
 use crate::link::{Request, MAX_REQUEST_FRAME};
 use crate::persist::ConfigOrigin;
+use crate::rig::as5047::Diagnostics;
 use crate::rig::config::RigConfig;
-use crate::rig::fixed::{Amps, Angle, Duty};
-use crate::rig::phase_lock::Motor;
+use crate::rig::fixed::{Angle, Duty};
 use crate::rig::selftest::{Case, Digest};
 
 /// A crank that follows the duty with a first-order lag, in integers (0.9 · 500 rad/s at full
-/// duty, τ = 60 ms, 1 ms steps).
+/// duty, τ = 60 ms, 1 ms steps), and a current sense reading 6/77 of the duty in counts.
 struct Crank {
     angle: Angle,
     speed_q16: i64,
     duty: i64,
 }
 
-impl Motor for Crank {
-    fn crank_angle(&mut self) -> Angle {
+impl Drive for Crank {
+    fn crank_raw(&mut self) -> Angle {
         self.angle
     }
-    fn current(&mut self) -> Amps {
-        Amps::from_bits((self.duty * 6) as i32)
+    fn current_counts(&mut self) -> u16 {
+        (self.duty.abs() * 6 / 77) as u16
     }
     fn set_duty(&mut self, d: Duty) {
         self.duty = i64::from(d.to_bits());
@@ -44,7 +45,8 @@ fn frame(seq: u8, req: &Request, d: &mut [u8; MAX_REQUEST_FRAME]) -> usize {
     encode(Header::new(seq), req, d).unwrap_or(0)
 }
 
-/// A conversation with the reference rig through its rig loop: version, a drive, telemetry,
+/// A conversation with the reference rig through its rig loop: version, a drive (after its
+/// pre-run check), telemetry,
 /// a damaged frame, a refused drive, the same configuration again, a stop — 8 s of samples at
 /// 10 kHz with a synthetic pendulum; the digest covers every byte the loop sends.
 fn rig_loop_conversation() -> u64 {
@@ -100,10 +102,17 @@ fn rig_loop_conversation() -> u64 {
             + 0.03 * libm::cos(crank.angle.to_rad());
         let due = rig.sample(Sample {
             t_us: t,
-            angle: Angle::from_rad(th),
+            count: (libm::round(th / crate::math::TAU * 16_384.0) as i64).rem_euclid(16_384) as u16,
             failed: k % 997 == 0,
             late: false,
             sensor_failed: false,
+            diagnostics: Some(Diagnostics {
+                agc: 96,
+                magnet_low: false,
+                magnet_high: false,
+                cordic_overflow: false,
+                ready: true,
+            }),
         });
         if due {
             let tick = rig.control(t, &mut crank, Some(false));
@@ -127,5 +136,5 @@ fn rig_loop_conversation() -> u64 {
 pub const CASES: &[Case] = &[Case {
     name: "rig_loop_conversation",
     run: rig_loop_conversation,
-    expected: 0x635e_cc64_88ce_2f03,
+    expected: 0x7ce3_ee96_155d_a715,
 }];

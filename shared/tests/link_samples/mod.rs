@@ -2,8 +2,8 @@
 //! round-trip, size and golden-frame tests.
 
 use kapitza_core::link::message::{
-    Counters, Fault, Mode, RMethod, ResetCause, ResetInfo, StopReason, Telemetry, VersionInfo,
-    WireConfig, WireGeometry,
+    Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
+    StopReason, Telemetry, Verdict, VersionInfo, WireConfig, WireGeometry,
 };
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{Reason, Request, Response, Status};
@@ -44,6 +44,8 @@ pub fn status() -> Status {
             cause: ResetCause::Watchdog,
             last_fault: Some(Fault::PhaseLockLost),
         },
+        check: Some(Check::Passed),
+        bring_up: None,
     }
 }
 
@@ -68,7 +70,52 @@ pub fn telemetry() -> Telemetry {
         theta_d_deg: 180 << 16,
         steady: true,
         commands: 4_000_000_000,
+        wobble: 4_588,
     }
+}
+
+pub fn raw() -> RawTelemetry {
+    RawTelemetry {
+        t_us: 123_456_789,
+        pendulum: Some(16_000),
+        crank: 3_000_000_000,
+        current: 2_048,
+        duty: -3_277,
+        diagnostics: Some(SensorDiagnostics {
+            agc: 97,
+            magnet_low: false,
+            magnet_high: false,
+            cordic_overflow: false,
+            ready: true,
+        }),
+        sensor_errors: 12,
+        theta_d_deg: 90 << 16,
+        commands: 5,
+    }
+}
+
+/// A configuration with every calibration field away from its default.
+pub fn calibrated_config() -> WireConfig {
+    let mut c = reference_config();
+    c.duty_max = 0.8;
+    c.calibration.pendulum_zero = 8_191;
+    c.calibration.pendulum_sign = -1;
+    c.calibration.crank_sign = -1;
+    c.calibration.servo_min_us = 600;
+    c.calibration.servo_max_us = 2_400;
+    c.calibration.servo_range_deg = 180.0;
+    c.calibration.servo_centre_deg = 85.5;
+    c.calibration.current_offset = 12.5;
+    c.calibration.current_scale = 1.2e-3;
+    c.calibration.hysteresis = 0.01;
+    c.calibration.min_swing = 0.02;
+    c.calibration.settle_band = 0.004;
+    c.calibration.block_s = 2.0;
+    c.calibration.quiet_blocks = 3;
+    c.closed_loop.enabled = true;
+    c.closed_loop.band = 0.02;
+    c.closed_loop.rate_max = 0.5;
+    c
 }
 
 /// Every message kind, every refusal reason, every config origin: (file name, seq, message).
@@ -118,7 +165,28 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
             8,
             Req(Request::SetConfig(general)),
         ),
+        (
+            "req_set_config_calibrated",
+            12,
+            Req(Request::SetConfig(calibrated_config())),
+        ),
         ("req_get_config", 9, Req(Request::GetConfig)),
+        (
+            "req_bring_up",
+            13,
+            Req(Request::BringUp {
+                duty: 3_277,
+                theta_d_deg: 90 << 16,
+            }),
+        ),
+        (
+            "req_bring_up_reverse",
+            14,
+            Req(Request::BringUp {
+                duty: -8_192,
+                theta_d_deg: -(10 << 16),
+            }),
+        ),
         (
             "req_telemetry",
             10,
@@ -150,6 +218,12 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
             201,
             Resp(Response::Telemetry(Telemetry::default())),
         ),
+        ("resp_raw", 202, Resp(Response::Raw(raw()))),
+        (
+            "resp_raw_empty",
+            203,
+            Resp(Response::Raw(RawTelemetry::default())),
+        ),
     ];
     for (i, (name, r)) in reasons().into_iter().enumerate() {
         v.push((name, 100 + i as u8, Resp(Response::Refused(r))));
@@ -165,6 +239,7 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
         ("status_faulted_wrong_direction", Fault::WrongDirection),
         ("status_faulted_phase_lock_lost", Fault::PhaseLockLost),
         ("status_faulted_over_current_rms", Fault::OverCurrentRms),
+        ("status_faulted_duty_ceiling", Fault::DutyCeiling),
     ]
     .into_iter()
     .enumerate()
@@ -173,6 +248,53 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
         s.mode = Mode::Faulted(f);
         v.push((name, 170 + i as u8, Resp(Response::Status(s))));
     }
+    // The pre-run check: running, and every verdict; bring-up mode.
+    for (i, (name, c)) in [
+        ("status_check_running", Check::Running),
+        ("status_check_passed", Check::Passed),
+        (
+            "status_check_sensor_silent",
+            Check::Failed(Verdict::SensorSilent),
+        ),
+        (
+            "status_check_sensor_not_ready",
+            Check::Failed(Verdict::SensorNotReady),
+        ),
+        (
+            "status_check_current_offset",
+            Check::Failed(Verdict::CurrentOffset { amps: 32_768 }),
+        ),
+        (
+            "status_check_crank_reversed",
+            Check::Failed(Verdict::CrankReversed { speed: -(45 << 16) }),
+        ),
+        (
+            "status_check_crank_stalled",
+            Check::Failed(Verdict::CrankStalled { speed: 0 }),
+        ),
+        (
+            "status_check_crank_too_fast",
+            Check::Failed(Verdict::CrankTooFast { speed: 400 << 16 }),
+        ),
+        ("status_check_aborted", Check::Failed(Verdict::Aborted)),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut s = status();
+        s.mode = if c == Check::Running {
+            Mode::Checking
+        } else {
+            Mode::Idle
+        };
+        s.check = Some(c);
+        v.push((name, 180 + i as u8, Resp(Response::Status(s))));
+    }
+    let mut s = status();
+    s.mode = Mode::Idle;
+    s.check = None;
+    s.bring_up = Some(3_277);
+    v.push(("status_bring_up", 190, Resp(Response::Status(s))));
     v
 }
 
@@ -216,6 +338,14 @@ pub fn reasons() -> Vec<(&'static str, Reason)> {
                 field: ConfigField::Rates,
             },
         ),
+        ("refused_check_running", Reason::CheckRunning),
+        (
+            "refused_duty_above_cap",
+            Reason::DutyAboveCap {
+                requested: 16_384,
+                cap: 8_192,
+            },
+        ),
     ]
 }
 
@@ -234,6 +364,12 @@ pub fn origins() -> Vec<(&'static str, ConfigOrigin)> {
             "status_config_invalid",
             ConfigOrigin::Defaults(Fallback::Invalid {
                 field: ConfigField::OmegaMax,
+            }),
+        ),
+        (
+            "status_config_invalid_crank_sign",
+            ConfigOrigin::Defaults(Fallback::Invalid {
+                field: ConfigField::CrankSign,
             }),
         ),
         (

@@ -46,6 +46,39 @@ impl Tuning {
         block_s: 1.0,
         quiet_blocks: 2,
     };
+
+    /// Checks every threshold: angles in (0, 0.5] rad (far above a sensor count, far below a
+    /// swing), the block in (0, 60] s, 1 to 100 quiet blocks.
+    pub fn validate(&self) -> Result<(), crate::ParamError> {
+        for (name, v) in [
+            ("hysteresis", self.hysteresis),
+            ("min_swing", self.min_swing),
+            ("settle_band", self.settle_band),
+        ] {
+            if !(v.is_finite() && v > 0.0 && v <= 0.5) {
+                return Err(crate::ParamError {
+                    name,
+                    value: v,
+                    allowed: "an angle in (0, 0.5] rad",
+                });
+            }
+        }
+        if !(self.block_s.is_finite() && self.block_s > 0.0 && self.block_s <= 60.0) {
+            return Err(crate::ParamError {
+                name: "block_s",
+                value: self.block_s,
+                allowed: "in (0, 60] s",
+            });
+        }
+        if !(1..=100).contains(&self.quiet_blocks) {
+            return Err(crate::ParamError {
+                name: "quiet_blocks",
+                value: f64::from(self.quiet_blocks),
+                allowed: "1 to 100 blocks",
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Everything the estimator knows, after the latest drive period.
@@ -139,6 +172,14 @@ impl Estimator {
 
     pub fn estimate(&self) -> &Estimate {
         &self.est
+    }
+
+    /// The fast wobble's amplitude (rad, Q30) as the latest drive period's I/Q demodulation
+    /// measures it; 0 before a period has completed.
+    pub fn wobble_now(&self) -> Unit {
+        self.last.map_or(Unit::ZERO, |pm| {
+            settle::wobble(pm.i, pm.q, pm.mean, self.theta_d, self.ell).0
+        })
     }
 
     /// One sample: stamp (µs, wrapping), pendulum angle, drive phase. Returns the estimate when

@@ -1,0 +1,204 @@
+//! The rig configuration as a checksummed record in flash: encoding, checking, and the fallback
+//! to safe defaults. Pure logic; the firmware reads and writes the bytes.
+//!
+//! ```text
+//! offset  size  field
+//! 0       4     magic "KPZC"
+//! 4       2     record format version (RECORD_VERSION), little-endian
+//! 6       2     payload length n, little-endian
+//! 8       n     postcard(WireConfig): the RigConfig field for field, f64 (link::message)
+//! 8+n     4     CRC-32C over bytes 0..8+n, little-endian (the link's CRC, link::frame::CRC)
+//! …             0xFF up to a multiple of 8 bytes (the STM32G4 programs 64-bit double words)
+//! ```
+//! [`load`] never fails: an erased page (all 0xFF) is [`Fallback::Missing`]; a wrong magic,
+//! length or CRC is [`Fallback::Corrupt`]; another format version is [`Fallback::Incompatible`];
+//! a record whose numbers [`RigConfig::validate`] refuses is [`Fallback::Invalid`]. In each case
+//! the rig runs on [`RigConfig::REFERENCE`] (the safe defaults) and the status says why
+//! ([`ConfigOrigin::Defaults`]). Bump [`RECORD_VERSION`] whenever [`WireConfig`]'s encoding
+//! changes (the link's golden frames catch that).
+//!
+//! **Migration.** A record of an older format that this firmware still reads loads as the
+//! current configuration, with the fields it lacked at their former build-time values:
+//!
+//! | version | payload | missing fields load as |
+//! |---|---|---|
+//! | 1 | [`v1::ConfigV1`] | `duty_max` 1, [`crate::rig::calibration::Calibration::DEFAULT`], closed loop off |
+//! | 2 | [`WireConfig`] | — |
+//!
+//! The origin stays [`ConfigOrigin::Stored`]; the record is rewritten in the new format at the
+//! next accepted `SetConfig`. Any other version is [`Fallback::Incompatible`].
+
+pub mod v1;
+
+use postcard::experimental::max_size::MaxSize;
+use serde::{Deserialize, Serialize};
+
+use crate::link::frame::CRC;
+use crate::link::reason::ConfigField;
+use crate::link::WireConfig;
+use crate::rig::config::RigConfig;
+
+/// "KPZC".
+pub const MAGIC: [u8; 4] = *b"KPZC";
+/// The record format version.
+pub const RECORD_VERSION: u16 = 2;
+const HEAD: usize = 8;
+/// The largest record, padding included: what the firmware reserves and writes.
+pub const RECORD_MAX: usize = (HEAD + WireConfig::POSTCARD_MAX_SIZE + 4).div_ceil(8) * 8;
+
+/// Why the stored configuration was not used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Fallback {
+    /// Nothing stored (the page is erased).
+    Missing,
+    /// Something is stored but its magic, length or checksum is wrong.
+    Corrupt,
+    /// A record of another format version (`version`).
+    Incompatible { version: u16 },
+    /// The record is intact but its configuration is out of range.
+    Invalid { field: ConfigField },
+}
+
+/// Where the configuration in use came from (reported in the status).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigOrigin {
+    /// Loaded from flash at power-up.
+    Stored,
+    /// The stored one was unusable: running on the safe defaults ([`RigConfig::REFERENCE`]).
+    Defaults(Fallback),
+    /// Set over the link since power-up; `saved` says whether it reached flash.
+    Received { saved: bool },
+}
+
+/// Writes the record of `cfg` into `out`; returns its length (a multiple of 8).
+pub fn encode(cfg: &RigConfig, out: &mut [u8; RECORD_MAX]) -> usize {
+    out.fill(0xFF);
+    out[..4].copy_from_slice(&MAGIC);
+    out[4..6].copy_from_slice(&RECORD_VERSION.to_le_bytes());
+    let n = match postcard::to_slice(&WireConfig::from(*cfg), &mut out[HEAD..RECORD_MAX - 4]) {
+        Ok(p) => p.len(),
+        // Cannot happen: the slice holds WireConfig::POSTCARD_MAX_SIZE bytes.
+        Err(_) => 0,
+    };
+    out[6..8].copy_from_slice(&(n as u16).to_le_bytes());
+    let crc = CRC.checksum(&out[..HEAD + n]);
+    out[HEAD + n..HEAD + n + 4].copy_from_slice(&crc.to_le_bytes());
+    (HEAD + n + 4).div_ceil(8) * 8
+}
+
+/// The configuration stored in `bytes` (a flash page, or any prefix of it that holds the
+/// record), checked, or why it cannot be used.
+pub fn decode(bytes: &[u8]) -> Result<RigConfig, Fallback> {
+    let head = bytes.get(..HEAD).ok_or(Fallback::Corrupt)?;
+    if head.iter().all(|&b| b == 0xFF) {
+        return Err(Fallback::Missing);
+    }
+    if head[..4] != MAGIC {
+        return Err(Fallback::Corrupt);
+    }
+    let version = u16::from_le_bytes([head[4], head[5]]);
+    let n = usize::from(u16::from_le_bytes([head[6], head[7]]));
+    if n > WireConfig::POSTCARD_MAX_SIZE {
+        return Err(if version == RECORD_VERSION {
+            Fallback::Corrupt
+        } else {
+            Fallback::Incompatible { version }
+        });
+    }
+    let body = bytes.get(..HEAD + n).ok_or(Fallback::Corrupt)?;
+    let crc = bytes.get(HEAD + n..HEAD + n + 4).ok_or(Fallback::Corrupt)?;
+    if CRC.checksum(body) != u32::from_le_bytes([crc[0], crc[1], crc[2], crc[3]]) {
+        return Err(Fallback::Corrupt);
+    }
+    let cfg = match version {
+        1 => RigConfig::from(payload::<v1::ConfigV1>(&body[HEAD..])?),
+        RECORD_VERSION => RigConfig::from(payload::<WireConfig>(&body[HEAD..])?),
+        _ => return Err(Fallback::Incompatible { version }),
+    };
+    cfg.validate().map_err(|e| Fallback::Invalid {
+        field: ConfigField::from_param_name(e.name),
+    })
+}
+
+/// A record's payload, all of it.
+fn payload<'a, T: Deserialize<'a>>(bytes: &'a [u8]) -> Result<T, Fallback> {
+    match postcard::take_from_bytes(bytes) {
+        Ok((w, [])) => Ok(w),
+        _ => Err(Fallback::Corrupt),
+    }
+}
+
+/// The configuration to run on, and where it came from: the stored one if it is intact and
+/// valid, else the safe defaults with the reason.
+pub fn load(bytes: &[u8]) -> (RigConfig, ConfigOrigin) {
+    match decode(bytes) {
+        Ok(c) => (c, ConfigOrigin::Stored),
+        Err(f) => (RigConfig::REFERENCE, ConfigOrigin::Defaults(f)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_fallbacks() {
+        let mut buf = [0u8; RECORD_MAX];
+        let mut cfg = RigConfig::REFERENCE;
+        cfg.amplitude = 0.0125;
+        let n = encode(&cfg, &mut buf);
+        assert_eq!(n % 8, 0);
+        assert!(n <= RECORD_MAX);
+        assert_eq!(load(&buf), (cfg, ConfigOrigin::Stored));
+        assert_eq!(decode(&buf[..n]), Ok(cfg));
+        // An erased page.
+        assert_eq!(decode(&[0xFF; 2048]), Err(Fallback::Missing));
+        let (c, o) = load(&[0xFF; 2048]);
+        assert_eq!(c, RigConfig::REFERENCE);
+        assert_eq!(o, ConfigOrigin::Defaults(Fallback::Missing));
+        // Every single flipped bit of the record (padding excluded) is caught.
+        let used = HEAD + usize::from(u16::from_le_bytes([buf[6], buf[7]])) + 4;
+        for i in 0..used * 8 {
+            let mut b = buf;
+            b[i / 8] ^= 1 << (i % 8);
+            assert!(decode(&b).is_err(), "bit {i}");
+        }
+        // Cut short.
+        assert_eq!(decode(&buf[..n - 9]), Err(Fallback::Corrupt));
+        assert_eq!(decode(&buf[..3]), Err(Fallback::Corrupt));
+        // The calibration and closed-loop fields are stored too.
+        cfg.calibration.pendulum_zero = 1234;
+        cfg.calibration.crank_sign = -1;
+        cfg.closed_loop.enabled = true;
+        cfg.limits.duty_max = 0.8;
+        encode(&cfg, &mut buf);
+        assert_eq!(decode(&buf), Ok(cfg));
+    }
+
+    #[test]
+    fn other_version_and_invalid_values() {
+        let mut buf = [0u8; RECORD_MAX];
+        encode(&RigConfig::REFERENCE, &mut buf);
+        // Re-seal with another version number: intact, but not ours.
+        let n = usize::from(u16::from_le_bytes([buf[6], buf[7]]));
+        buf[4] = 3;
+        let crc = CRC.checksum(&buf[..HEAD + n]);
+        buf[HEAD + n..HEAD + n + 4].copy_from_slice(&crc.to_le_bytes());
+        assert_eq!(decode(&buf), Err(Fallback::Incompatible { version: 3 }));
+        // Intact but out of range.
+        let mut bad = RigConfig::REFERENCE;
+        bad.gravity = -1.0;
+        encode(&bad, &mut buf);
+        assert_eq!(
+            load(&buf),
+            (
+                RigConfig::REFERENCE,
+                ConfigOrigin::Defaults(Fallback::Invalid {
+                    field: ConfigField::Gravity
+                })
+            )
+        );
+    }
+}
