@@ -617,3 +617,159 @@ fn a_reversed_crank_fails_the_pre_run_check_and_set_exits_1_with_the_reason() {
     assert_eq!(s["calibration"]["crank_sign"], -1);
     owner.interrupt();
 }
+
+/// `set --r 1.75 --angle 90 --wait --json` on `port`: the settled angle and the model's (deg).
+fn settle_at_1_75(port: &str) -> (f64, f64) {
+    let o = kapitza(&[
+        "set",
+        "--port",
+        port,
+        "--r",
+        "1.75",
+        "--angle",
+        "90",
+        "--wait",
+        "--timeout",
+        "120",
+        "--json",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v = json(&o);
+    assert_eq!(v["settled"], true, "{v}");
+    (
+        v["slow_angle_deg"].as_f64().unwrap(),
+        v["predicted"]["phi0_deg"].as_f64().unwrap(),
+    )
+}
+
+/// What `calibrate --json` wrote in `step` under `key`.
+fn wrote(v: &Value, step: &str, key: &str) -> f64 {
+    v["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["step"] == step)
+        .unwrap_or_else(|| panic!("no step {step}: {v}"))["wrote"][key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{step}.{key}: {v}"))
+}
+
+fn measured(v: &Value, step: &str, key: &str) -> f64 {
+    v["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["step"] == step)
+        .unwrap()["measured"][key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{step}.{key}: {v}"))
+}
+
+/// `kapitza calibrate --yes --json` on `port` (one `step`, or all), its backup in `dir`.
+fn calibrate(port: &str, dir: &std::path::Path, step: Option<&str>) -> (Value, std::path::PathBuf) {
+    let backup = dir.join(format!("before-{}.toml", step.unwrap_or("all")));
+    let mut args = vec!["calibrate", "--port", port, "--yes", "--json"];
+    args.extend(["--backup", backup.to_str().unwrap()]);
+    if let Some(s) = step {
+        args.extend(["--step", s]);
+    }
+    let o = kapitza(&args);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (json(&o), backup)
+}
+
+#[test]
+fn calibration_recovers_the_mistyped_rig_and_fixes_its_settle_angle() {
+    // rigs/mistyped.toml. Truth: L = 0.25 m (typed 0.26), A = 12.7 mm (typed 12.5), the sensor
+    // reads 1.5° low (zero count −1.5/360·16384 = −68.3 → 16315.7), Q = 10, Coulomb μ = 0.3
+    // rad/s², the servo's mount 2° past what it is told.
+    let dir = tempfile::tempdir().unwrap();
+    let rig = serve(&[
+        "--sim",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../rigs/mistyped.toml"),
+    ]);
+    let port = rig.first_line.as_str();
+    // Before: R 7.4 % high ((12.7/12.5)²·0.26/0.25), the mount 2° and the zero 1.5° off.
+    let (before, model) = settle_at_1_75(port);
+
+    let (v, backup) = calibrate(port, dir.path(), None);
+    // Tolerances: docs/calibration.md (kapitza_core::calib::tolerance).
+    let length = wrote(&v, "ringdown", "pendulum.length");
+    let a = wrote(&v, "stroke", "amplitude");
+    let q = measured(&v, "ringdown", "q");
+    let mu = measured(&v, "ringdown", "coulomb");
+    let zero = wrote(&v, "sensor", "pendulum_zero");
+    let mount = measured(&v, "stroke", "mount_deg");
+    assert!((length / 0.25 - 1.0).abs() < 0.004, "L {length}");
+    assert!((a / 0.0127 - 1.0).abs() < 0.004, "A {a}");
+    assert!((q / 10.0 - 1.0).abs() < 0.10, "Q {q}");
+    assert!((mu / 0.3 - 1.0).abs() < 0.10, "μ {mu}");
+    assert!(
+        ((zero - 16_315.7) * 360.0 / 16_384.0).abs() < 0.2,
+        "zero count {zero}"
+    );
+    assert_eq!(wrote(&v, "sensor", "pendulum_sign"), 1.0);
+    assert_eq!(wrote(&v, "crank", "crank_sign"), 1.0);
+    assert!((mount - 92.0).abs() < 0.3, "mount {mount}");
+
+    let (after, model_after) = settle_at_1_75(port);
+    eprintln!(
+        "calibrated: L {length:.5} m, A {a:.6} m, Q {q:.2}, μ {mu:.3}, zero count {zero}, \
+         mount {mount:.2}°; settled at R = 1.75, θd = 90°: before {before:.2}° (model \
+         {model:.2}°), after {after:.2}° (model {model_after:.2}°)"
+    );
+    assert!((before - model).abs() > 1.5, "before {before} vs {model}");
+    assert!(
+        (after - model_after).abs() < 0.5,
+        "after {after} vs {model_after}"
+    );
+
+    // The backup puts the configuration back.
+    let o = kapitza(&["config", "set", "--port", port, backup.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let got = String::from_utf8(kapitza(&["config", "get", "--port", port]).stdout).unwrap();
+    assert!(got.contains("length = 0.26"), "{got}");
+}
+
+#[test]
+fn calibration_finds_reversed_directions() {
+    // rigs/mistyped.toml with its sensor and crank encoder wired backwards: the sensor then
+    // reads −(θ − 1.5°), +1.5° hanging, count 68.3.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("rig.toml");
+    let base = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../rigs/mistyped.toml"
+    ))
+    .unwrap();
+    let text = base
+        .replace("zero_deg = 1.5", "zero_deg = 1.5\nreversed = true")
+        .replace("[servo]", "[crank]\nreversed = true\n\n[servo]");
+    std::fs::write(&file, text).unwrap();
+    let rig = serve(&["--sim", file.to_str().unwrap()]);
+    let port = rig.first_line.as_str();
+    let (v, _) = calibrate(port, dir.path(), Some("crank"));
+    assert_eq!(wrote(&v, "crank", "crank_sign"), -1.0);
+    let (v, _) = calibrate(port, dir.path(), Some("sensor"));
+    assert_eq!(wrote(&v, "sensor", "pendulum_sign"), -1.0);
+    let zero = wrote(&v, "sensor", "pendulum_zero");
+    assert!(
+        ((zero - 68.27) * 360.0 / 16_384.0).abs() < 0.2,
+        "zero count {zero}"
+    );
+}

@@ -6,9 +6,9 @@ mod closed_loop_sim;
 
 use closed_loop_sim::Sim;
 use kapitza_core::math;
+use kapitza_core::rig::closed_loop::ClosedLoopR as Settings;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::dds::{omega_of_word, word_from_omega};
-use kapitza_core::rig::r_trim::Settings;
 use kapitza_core::rig::safety::Request;
 
 const TRUE_A: f64 = 0.0127;

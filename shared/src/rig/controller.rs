@@ -10,12 +10,12 @@
 //!                     pendulum has settled ([`super::r_trim`])
 //! ```
 
+use super::closed_loop::ClosedLoopR;
 use super::config::RigConfig;
 use super::dds::Dds;
 use super::estimator::{Estimate, Estimator, Tuning};
 use super::fixed::{Angle, Duty, RadPerSec};
 use super::phase_lock::{LockOutput, Motor, PhaseLock};
-use super::closed_loop::ClosedLoopR;
 use super::r_trim::RTrim;
 use super::safety::{Inputs, Mode, Refusal, Request, Supervisor};
 

@@ -17,24 +17,17 @@
 //! measures, steps, and waits, never chasing a pendulum in motion. A new `SetDrive`, a stop, a
 //! fault, or switching the loop off returns to the open-loop ω of the R asked for.
 
+use super::closed_loop::ClosedLoopR;
 use crate::math;
 
 /// The farthest the trim may move R_cmd from R asked (relative): a wrong in-situ reading (the
 /// pendulum knocked off its equilibrium) must not run the drive away.
 pub const MAX_TRIM: f64 = 0.25;
 
-/// The settings: on or off, the band left alone (R), the fastest R_cmd may move (R per second).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
-    pub enabled: bool,
-    pub band: f64,
-    pub rate_max: f64,
-}
-
 /// The trim's state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RTrim {
-    settings: Settings,
+    settings: ClosedLoopR,
     /// ωc = √(2gℓ)/A from the configuration (rad/s), and the drive's ω limit.
     omega_c: f64,
     omega_max: f64,
@@ -46,7 +39,7 @@ pub struct RTrim {
 }
 
 impl RTrim {
-    pub fn new(settings: Settings, omega_c: f64, omega_max: f64) -> Self {
+    pub fn new(settings: ClosedLoopR, omega_c: f64, omega_max: f64) -> Self {
         Self {
             settings,
             omega_c,
@@ -67,7 +60,7 @@ impl RTrim {
 
     /// Switches the loop on or off (band and rate as given). Off: the ω to return to, the
     /// open-loop ω of the R asked for, if a trim had moved it.
-    pub fn set(&mut self, settings: Settings, now_us: u32) -> Option<f64> {
+    pub fn set(&mut self, settings: ClosedLoopR, now_us: u32) -> Option<f64> {
         self.settings = settings;
         if settings.enabled || self.cmd == self.asked || self.asked <= 0.0 {
             return None;
@@ -82,7 +75,7 @@ impl RTrim {
         self.cmd
     }
 
-    pub fn settings(&self) -> Settings {
+    pub fn settings(&self) -> ClosedLoopR {
         self.settings
     }
 
@@ -121,7 +114,7 @@ impl RTrim {
 mod tests {
     use super::*;
 
-    const ON: Settings = Settings {
+    const ON: ClosedLoopR = ClosedLoopR {
         enabled: true,
         band: 0.01,
         rate_max: 0.1,
@@ -148,7 +141,7 @@ mod tests {
         // Off: back to the open-loop ω of 1.75.
         let back = t
             .set(
-                Settings {
+                ClosedLoopR {
                     enabled: false,
                     ..ON
                 },
@@ -175,7 +168,7 @@ mod tests {
         assert!((t.commanded() - 2.25).abs() < 1e-12 && w <= 150.0);
         // Off by default: nothing ever.
         let mut t = RTrim::new(
-            Settings {
+            ClosedLoopR {
                 enabled: false,
                 ..ON
             },
