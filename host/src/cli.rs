@@ -29,6 +29,7 @@ pub enum Command {
     Stop(cmd::stop::StopArgs),
     Clear(cmd::stop::ClearArgs),
     Config(cmd::config::Args),
+    Calibrate(cmd::calibrate::Args),
     /// A simulated rig for serial clients.
     Rig(cmd::rig_serve::Args),
     Monitor(cmd::monitor::Args),
@@ -103,6 +104,7 @@ where
         Command::Stop(a) => cmd::stop::stop(&a, out)?,
         Command::Clear(a) => cmd::stop::clear(&a, out)?,
         Command::Config(a) => cmd::config::run(&a, out)?,
+        Command::Calibrate(a) => cmd::calibrate::run(&a, out)?,
         Command::Rig(a) => cmd::rig_serve::run(&a, out)?,
         Command::Monitor(a) => cmd::monitor::run(&a, out)?,
         Command::Demo(a) => cmd::demo::run(&a, out)?,

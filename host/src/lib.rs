@@ -5,6 +5,7 @@
 //! | module | concept |
 //! |---|---|
 //! | [`bench`] | `kapitza bench`: work-precision, the peer, the stability ladder, the physical question |
+//! | [`calibrate`] | `kapitza calibrate`: the guided steps over the link, the person at the rig, what is written |
 //! | [`chart`] | the field's charts: stability, equilibria and outcome maps, drawn as PNG and SVG |
 //! | [`cli`] | parsing, dispatch, and the error type that picks the exit status |
 //! | [`demo`] | the lecture demo as a script over the monitor's feed, measured against predicted |
@@ -21,6 +22,7 @@
 //! | [`timing`] | measured cost of a function |
 
 pub mod bench;
+pub mod calibrate;
 pub mod chart;
 pub mod cli;
 pub mod cmd;

@@ -23,6 +23,7 @@
 //! | [`persist`] | the rig configuration as a checksummed flash record, with migration and the fallback to safe defaults |
 //! | [`station`] | the rig loop: one rig and its link end, hardware-free (samples, control ticks, bytes in → frames out), with the server that answers requests and the pre-run check; run by the firmware, the on-target tests and the simulated rig |
 //! | [`simrig`] | the simulated rig: the pendulum's full equation on the crank's actual angle, motor, sensors, servo and e-stop, around a [`station::RigLoop`] |
+//! | [`calib`] | calibration from what the rig reports: sensor zero and direction, crank direction, servo map, current offset, ℓ and damping from a ring-down, the stroke from the wobble |
 //! | [`selftest`] | deterministic scenarios with digests, run on the host and on the emulated MCU |
 //!
 //! # Conventions (physics §2–3)
@@ -41,6 +42,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod calib;
 pub mod cases;
 pub mod checksum;
 pub mod error;

@@ -282,6 +282,11 @@ fn merge(base: &mut toml::Table, over: toml::Table) {
     }
 }
 
+/// `cfg` as the TOML file `get` prints and `set` reads.
+pub fn to_toml(cfg: &RigConfig) -> Result<String> {
+    Ok(toml::to_string(&ConfigFile::from(cfg))?)
+}
+
 /// The configuration `file` describes, on top of `current`.
 pub fn read(file: &std::path::Path, current: &RigConfig) -> Result<RigConfig> {
     let text =
@@ -306,7 +311,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
             if *json {
                 writeln!(out, "{}", serde_json::to_string_pretty(&f)?)?;
             } else {
-                write!(out, "{}", toml::to_string(&f)?)?;
+                write!(out, "{}", to_toml(&s.config)?)?;
             }
         }
         Action::Set { rig, file } => {

@@ -3,6 +3,7 @@
 pub mod attach;
 pub mod bench;
 pub mod boundary;
+pub mod calibrate;
 pub mod chart;
 pub mod config;
 pub mod demo;

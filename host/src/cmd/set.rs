@@ -43,6 +43,11 @@ pub struct Args {
     /// One JSON object at the end (the keys of `kapitza status --json`); progress goes to stderr.
     #[arg(long)]
     pub json: bool,
+    /// Closed-loop R: `on` trims ω once settled so the R measured in situ is the R asked for
+    /// (within the configuration's `closed_loop` band and rate); `off` returns to open loop.
+    /// Stored in the rig's configuration.
+    #[arg(long, value_name = "on|off", value_parser = ["on", "off"])]
+    pub closed_loop: Option<String>,
 }
 
 /// The pre-run check takes 0.6 s of rig time; a verdict later than this means a lost rig.
@@ -68,6 +73,14 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let timeout = crate::input::positive("--timeout", args.timeout)?;
     rig::catch_interrupt();
     let mut s = args.rig.connect()?;
+    if let Some(on) = &args.closed_loop {
+        let mut cfg = s.config;
+        cfg.closed_loop.enabled = on == "on";
+        if cfg != s.config {
+            s.call(|c| c.set_config(&cfg))?;
+            s.config = cfg;
+        }
+    }
     let starts = args.r > 0.0 && s.call(|c| c.status())?.mode == Mode::Idle;
     s.call(|c| c.set_drive(args.r, args.angle))?;
     if starts {

@@ -10,6 +10,7 @@
 //! keys: s stop (always shown), c clear fault, q quit
 //! ```
 
+use kapitza_core::rig::closed_loop::ClosedLoopR;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::symbols::Marker;
@@ -33,7 +34,7 @@ fn num(x: Option<f64>, prec: usize) -> String {
 pub fn draw(frame: &mut Frame, state: &State) {
     let [title, panels, chart, log, keys] = Layout::vertical([
         Constraint::Length(1),
-        Constraint::Length(8),
+        Constraint::Length(9),
         Constraint::Min(6),
         Constraint::Length(6),
         Constraint::Length(1),
@@ -119,8 +120,21 @@ fn drive_panel(r: Option<&Readings>) -> Paragraph<'static> {
             " commands {}",
             r.map_or("—".into(), |r| r.commands.to_string())
         )),
+        Line::from(format!(
+            " closed-loop R {}",
+            closed_loop(r.and_then(|r| r.closed_loop))
+        )),
     ];
     Paragraph::new(lines).block(Block::bordered().title(" drive "))
+}
+
+/// Closed-loop R as one phrase: off, or on with its band and rate.
+pub fn closed_loop(c: Option<ClosedLoopR>) -> String {
+    match c {
+        None => "—".into(),
+        Some(c) if !c.enabled => "off (open loop)".into(),
+        Some(c) => format!("on, band ±{:.3}, ≤ {:.2}/s", c.band, c.rate_max),
+    }
 }
 
 fn pendulum_panel(r: Option<&Readings>) -> Paragraph<'static> {

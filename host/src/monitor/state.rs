@@ -2,6 +2,7 @@
 //! it keeps the latest snapshot, the slow angle's history and an event log, and turns keys into
 //! [`Command`]s. No I/O here, so every transition is testable.
 
+use kapitza_core::rig::closed_loop::ClosedLoopR;
 use std::collections::VecDeque;
 
 use serde::Serialize;
@@ -85,6 +86,10 @@ pub struct Readings {
     pub steady: bool,
     /// Commands the rig has carried out.
     pub commands: u32,
+    /// Closed-loop R's settings (the configuration's), once the configuration is known; the
+    /// dashboard shows them, the JSON keys stay as they were.
+    #[serde(skip)]
+    pub closed_loop: Option<ClosedLoopR>,
 }
 
 /// An angle as the chart shows it, in [−90°, 270°): every equilibrium reachable within the
@@ -299,6 +304,7 @@ impl State {
             settled: t.settled,
             steady: t.steady,
             commands: t.commands,
+            closed_loop: cfg.map(|c| c.closed_loop),
         })
     }
 }

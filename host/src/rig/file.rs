@@ -74,6 +74,8 @@ struct RawRig {
     current: RawCurrent,
     #[serde(default)]
     initial: RawInitial,
+    #[serde(default)]
+    operator: RawOperator,
     seed: Option<u64>,
     configured: Option<RawConfigured>,
 }
@@ -114,6 +116,13 @@ struct RawCoulomb {
 )]
 struct RawSliderCrank {
     rod_length: f64,
+}
+
+/// `[operator]`: a simulated lab hand for `kapitza calibrate` (`simrig::hand`).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields, expecting = "a table: [operator] release_deg = …")]
+struct RawOperator {
+    release_deg: Option<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -375,6 +384,16 @@ fn convert(raw: RawRig) -> Result<RigFile> {
             180.0,
             "in [-180, 180] degrees",
         )?),
+        hand: match raw.operator.release_deg {
+            Some(d) => Some(math::to_rad(in_range(
+                "operator.release_deg",
+                d,
+                5.0,
+                60.0,
+                "in [5, 60] degrees counter-clockwise",
+            )?)),
+            None => None,
+        },
         seed: raw.seed.unwrap_or(1),
     };
     let mut config = params.configured();

@@ -6,14 +6,17 @@
 //! control tick (fc):  motor → (crank angle, current);  safety.check → run / ramp / halt, θd;
 //!                     DDS target or halt (a start aligns the DDS phase to the crank);
 //!                     phase lock → duty → motor;  estimator restarts its slow history while
-//!                     the drive ramps or θd slews
+//!                     the drive ramps or θd slews;  closed-loop R (when on) trims ω once the
+//!                     pendulum has settled ([`super::r_trim`])
 //! ```
 
+use super::closed_loop::ClosedLoopR;
 use super::config::RigConfig;
 use super::dds::Dds;
 use super::estimator::{Estimate, Estimator, Tuning};
 use super::fixed::{Angle, Duty, RadPerSec};
 use super::phase_lock::{LockOutput, Motor, PhaseLock};
+use super::r_trim::RTrim;
 use super::safety::{Inputs, Mode, Refusal, Request, Supervisor};
 
 /// What one control tick did.
@@ -41,6 +44,7 @@ pub struct Rig {
     sensor_failed: bool,
     phase_error: RadPerSec,
     saturated: bool,
+    trim: RTrim,
 }
 
 impl Rig {
@@ -55,6 +59,11 @@ impl Rig {
             sensor_failed: false,
             phase_error: RadPerSec::ZERO,
             saturated: false,
+            trim: RTrim::new(
+                cfg.closed_loop,
+                cfg.omega_for_r(1.0).unwrap_or(f64::INFINITY),
+                cfg.limits.omega_max,
+            ),
         }
     }
 
@@ -67,6 +76,26 @@ impl Rig {
     /// A command; refused ones change nothing.
     pub fn request(&mut self, req: Request) -> Result<(), Refusal> {
         self.sup.request(req)
+    }
+
+    /// The drive strength R asked for with the last drive request (0: stopped): closed-loop R
+    /// holds the in-situ R at it; the drive starts from its open-loop ω.
+    pub fn r_asked(&mut self, r: f64) {
+        self.trim.asked(r);
+    }
+
+    /// Closed-loop R on or off (band, rate); off returns ω to the open-loop ω of the R asked
+    /// for. `now_us` on the rig's clock.
+    pub fn set_closed_loop(&mut self, settings: ClosedLoopR, now_us: u32) {
+        if let Some(omega) = self.trim.set(settings, now_us) {
+            // The open-loop ω of an accepted R is within the limits: the request cannot fail.
+            let _ = self.sup.request(Request::SetOmega { omega });
+        }
+    }
+
+    /// The closed-loop R's state: its settings and the R the drive's ω stands for.
+    pub fn r_trim(&self) -> &RTrim {
+        &self.trim
     }
 
     /// The pendulum sensor's driver says it has failed (or recovered); the next control tick
@@ -134,6 +163,16 @@ impl Rig {
             && out.theta_d == self.sup.theta_d_target();
         if !steady {
             self.est.reset_slow(out.theta_d);
+        }
+        let e = self.est.estimate();
+        let settled_r = match e.r {
+            Some((r, _)) if steady && e.settled => Some(r.to_num::<f64>()),
+            _ => None,
+        };
+        if let Some(omega) = self.trim.update(t_us, settled_r) {
+            // Within the limits by construction (r_trim clamps to ω_max); a refusal (the mode
+            // changed this tick) leaves the drive as it was.
+            let _ = self.sup.request(Request::SetOmega { omega });
         }
         ControlReport {
             mode: self.sup.mode(),

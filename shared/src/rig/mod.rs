@@ -17,6 +17,7 @@
 //! | [`as5047`] | the pendulum sensor's SPI frames: parity, the error flag and its clearing read, diagnostics (magnet), health |
 //! | [`estop`] | the e-stop line debounced at the control tick; unknown counts as pressed |
 //! | [`safety`] | limits, refusals with reasons, stall / over-current / e-stop faults, the link-silence policy |
+//! | [`r_trim`] | closed-loop R: once settled, ω trimmed so the in-situ R equals the R asked for, within a band and a rate limit |
 //! | [`controller`] | one rig: the above composed into a sample tick and a control tick |
 //! | [`servo`] | θd → the tilt servo's pulse; the θd the rig starts from after a reset |
 //! | [`retained`] | the last θd and fault, kept in RAM across a reset with a CRC |
@@ -42,6 +43,7 @@ pub mod estimator;
 pub mod estop;
 pub mod fixed;
 pub mod phase_lock;
+pub mod r_trim;
 pub mod retained;
 pub mod safety;
 pub mod servo;

@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`plant`] | the pendulum driven by the crank's actual angle, the DC motor, friction |
 //! | [`sensor`] | the pendulum sensor's chip behind its SPI pins (AS5047P), with its faults |
+//! | [`hand`] | a lab hand that lifts and lets go of the pendulum when calibration asks for it |
 //!
 //! ```text
 //! every sample period h = 1/fs:
@@ -24,6 +25,7 @@
 //! *configured* calibration, so a mis-calibrated configuration is visibly off.
 //! Everything is deterministic under [`Params::seed`].
 
+pub mod hand;
 pub mod plant;
 pub mod sensor;
 
@@ -39,7 +41,9 @@ use crate::rig::fixed::{Angle, Duty};
 use crate::rig::servo::ServoMap;
 use crate::sim::noise::Noise;
 use crate::station::drive::Drive;
+use crate::station::serve::Activity;
 use crate::station::{RigLoop, Sample};
+use hand::Hand;
 use plant::{MotorModel, Plant};
 use sensor::{Chip, Line};
 
@@ -79,6 +83,9 @@ pub struct Params {
     pub sensor_line: Line,
     /// The pendulum's angle (rad) at power-up, at rest.
     pub theta0: f64,
+    /// A lab hand ([`hand`]): how far it lifts the pendulum counter-clockwise (rad) whenever
+    /// the rig enters bring-up mode with the motor off; `None`: nobody at the rig.
+    pub hand: Option<f64>,
     pub seed: u64,
 }
 
@@ -104,6 +111,7 @@ impl Params {
         stalled: false,
         sensor_line: Line::Connected,
         theta0: 0.0,
+        hand: None,
         seed: 1,
     };
 
@@ -138,6 +146,7 @@ pub struct SimRig {
     /// The last good count (a failed read repeats it, as the firmware does).
     held: u16,
     stats: Stats,
+    hand: Option<Hand>,
 }
 
 impl SimRig {
@@ -177,6 +186,7 @@ impl SimRig {
             driver: As5047::new(),
             held: 0,
             stats: Stats::default(),
+            hand: params.hand.map(Hand::new),
             params,
         };
         s.chip.line = params.sensor_line;
@@ -246,7 +256,25 @@ impl SimRig {
         let h = 1.0 / f64::from(self.rig.sample_hz());
         self.slew_servo(h);
         self.y = rk4_step(&self.plant, self.seconds(), &self.y, h, &mut self.stats);
+        self.lend_a_hand();
         self.k += 1;
+    }
+
+    /// The lab hand, if there is one: armed while the rig is in bring-up mode with the motor
+    /// off (where calibration asks for a release), it holds the pendulum while it lifts it.
+    fn lend_a_hand(&mut self) {
+        let t = self.seconds();
+        let Some(hand) = &mut self.hand else {
+            return;
+        };
+        let armed = matches!(
+            self.rig.server().activity,
+            Activity::BringUp { duty } if duty == Duty::ZERO
+        );
+        if let Some(theta) = hand.step(t, armed, self.y[0]) {
+            self.y[0] = theta;
+            self.y[1] = 0.0;
+        }
     }
 
     /// Runs `secs` of rig time with the link's clock the rig's own.

@@ -58,6 +58,7 @@ pub fn apply(rig: &mut Rig, cfg: &RigConfig, cmd: Command) -> Result<(), Reason>
             trial.request(Sr::SetDriveAngle {
                 deg: from_q16(theta_d_deg),
             })?;
+            trial.r_asked(from_q16(r));
             if r == 0 {
                 trial.request(Sr::Stop)?;
             } else {
@@ -361,7 +362,8 @@ impl RigServer {
         Ok(())
     }
 
-    /// A new configuration: valid, and the rig idle; the rig restarts on it with θd kept.
+    /// A new configuration: valid, and the rig idle; the rig restarts on it with θd kept. A
+    /// change of closed-loop R alone is taken in any mode.
     /// The one already in use and in flash is accepted as it is (`None`: nothing to store, so
     /// a repeated `SetConfig` never wears the flash page).
     fn set_config(&mut self, w: WireConfig, at: Clock) -> Result<Option<RigConfig>, Reason> {
@@ -372,6 +374,18 @@ impl RigServer {
         );
         if cfg == self.cfg && in_flash {
             return Ok(None);
+        }
+        let others = RigConfig {
+            closed_loop: self.cfg.closed_loop,
+            ..cfg
+        };
+        if others == self.cfg {
+            // Only closed-loop R changed: taken at once, running or not (off returns the drive
+            // to the open-loop ω of the R asked for), and stored.
+            self.rig.set_closed_loop(cfg.closed_loop, at.rig_us);
+            self.cfg = cfg;
+            self.origin = ConfigOrigin::Received { saved: false };
+            return Ok(Some(cfg));
         }
         config_change_allowed(&self.rig)?;
         match self.activity {

@@ -1,0 +1,113 @@
+//! `kapitza calibrate`: measure the bench and write what it is into the rig's configuration.
+//!
+//! The steps (`--step NAME` reruns one) and their formulas are in `crate::calibrate` and
+//! docs/calibration.md. Before anything is written, the configuration the rig had is saved to a
+//! file (`--backup`, default `kapitza-config-before-calibrate-<unix time>.toml` in the current
+//! directory), as `kapitza config get` prints it; `kapitza config set FILE` restores it.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+
+use super::rig_args::RigArgs;
+use crate::calibrate::operator::Operator;
+use crate::calibrate::steps::Calibrator;
+use crate::calibrate::{Step, StepReport};
+use crate::rig;
+
+/// Calibrate the rig: pendulum sensor direction and zero, crank direction, servo map and
+/// current offset, the pendulum's length and damping from a ring-down, the stroke from the fast
+/// wobble. Each step says what to do and what it measured, refuses to go on when a measurement
+/// is implausible, and writes its result into the rig's configuration (stored in flash).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    pub rig: RigArgs,
+    /// Run only this step (the others keep the rig's values).
+    #[arg(long, value_enum, value_name = "NAME")]
+    pub step: Option<Step>,
+    /// Plain lines, no prompts' decoration (for scripts).
+    #[arg(long)]
+    pub plain: bool,
+    /// One JSON object at the end (steps, measurements, fields written, the backup);
+    /// prompts and progress go to stderr.
+    #[arg(long)]
+    pub json: bool,
+    /// Do not wait for confirmations (nobody at the rig: a simulated rig's hand does the
+    /// lifting; the servo's map is then corrected from the pendulum instead of marks).
+    #[arg(long)]
+    pub yes: bool,
+    /// Where to save the configuration the rig had before.
+    #[arg(long, value_name = "FILE")]
+    pub backup: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct Summary<'a> {
+    rig: &'a str,
+    backup: String,
+    restore: String,
+    steps: &'a [StepReport],
+}
+
+pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    rig::catch_interrupt();
+    let s = args.rig.connect()?;
+    let name = s.name.clone();
+    let backup = args.backup.clone().unwrap_or_else(|| {
+        let t = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs());
+        PathBuf::from(format!("kapitza-config-before-calibrate-{t}.toml"))
+    });
+    std::fs::write(&backup, super::config::to_toml(&s.config)?)
+        .with_context(|| format!("cannot save the configuration to {}", backup.display()))?;
+    let restore = format!("kapitza config set {}", backup.display());
+    let mut progress: Box<dyn Write> = if args.json {
+        Box::new(std::io::stderr())
+    } else {
+        Box::new(&mut *out)
+    };
+    writeln!(
+        progress,
+        "{name}: the configuration it had is saved to {} (restore: `{restore}`)",
+        backup.display()
+    )?;
+    let op = Operator {
+        yes: args.yes,
+        plain: args.plain,
+        out: &mut *progress,
+    };
+    let mut cal = Calibrator::new(s, op);
+    let steps: Vec<Step> = match args.step {
+        Some(s) => vec![s],
+        None => Step::ALL.to_vec(),
+    };
+    let mut reports = Vec::new();
+    for step in steps {
+        if rig::interrupted() {
+            anyhow::bail!("interrupted; the steps before were written");
+        }
+        let r = cal.run(step)?;
+        cal.write()?;
+        cal.op.say(&r.text())?;
+        reports.push(r);
+    }
+    cal.op.say(&format!(
+        "{name}: calibrated and stored; `{restore}` goes back"
+    ))?;
+    drop(cal);
+    drop(progress);
+    if args.json {
+        let summary = Summary {
+            rig: &name,
+            backup: backup.display().to_string(),
+            restore,
+            steps: &reports,
+        };
+        writeln!(out, "{}", serde_json::to_string_pretty(&summary)?)?;
+    }
+    Ok(())
+}
