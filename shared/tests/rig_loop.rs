@@ -77,13 +77,7 @@ impl Bench {
                 failed: false,
                 late: false,
                 sensor_failed: false,
-                diagnostics: Some(Diagnostics {
-                    agc: 96,
-                    magnet_low: false,
-                    magnet_high: false,
-                    cordic_overflow: false,
-                    ready: true,
-                }),
+                diagnostics: Some(Diagnostics::HEALTHY),
             });
             if due {
                 let tick = self.rig.control(self.link_us, &mut self.crank, self.estop);

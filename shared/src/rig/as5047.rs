@@ -99,6 +99,15 @@ pub struct Diagnostics {
 }
 
 impl Diagnostics {
+    /// A ready sensor with the magnet in range (AGC mid-scale): what a healthy bench reads.
+    pub const HEALTHY: Self = Self {
+        agc: 96,
+        magnet_low: false,
+        magnet_high: false,
+        cordic_overflow: false,
+        ready: true,
+    };
+
     /// The field is in range and the angle computation valid.
     pub fn magnet_ok(&self) -> bool {
         !(self.magnet_low || self.magnet_high || self.cordic_overflow)

@@ -106,13 +106,7 @@ fn rig_loop_conversation() -> u64 {
             failed: k % 997 == 0,
             late: false,
             sensor_failed: false,
-            diagnostics: Some(Diagnostics {
-                agc: 96,
-                magnet_low: false,
-                magnet_high: false,
-                cordic_overflow: false,
-                ready: true,
-            }),
+            diagnostics: Some(Diagnostics::HEALTHY),
         });
         if due {
             let tick = rig.control(t, &mut crank, Some(false));
