@@ -2,13 +2,11 @@
 //! the sensors streamed raw (pendulum counts, crank encoder, ADC counts, the AS5047P's
 //! diagnostics), and every way out of it — stop, link silence, a fault.
 
-mod sim_bench;
-
 use kapitza_core::link::message::{Fault, Mode, RawTelemetry};
 use kapitza_core::link::{Reason, Request, Response};
 use kapitza_core::simrig::Params;
 use kapitza_core::station::serve::BRING_UP_DUTY_MAX;
-use sim_bench::Bench;
+use kapitza_test_support::sim_bench::Bench;
 
 /// A duty in I1F15 bits.
 fn q15(d: f64) -> i16 {

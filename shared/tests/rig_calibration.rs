@@ -1,13 +1,11 @@
 //! The calibration in use: the simulated rig's sensor has its own zero and direction (its
 //! truth), read through the configured calibration, as a real bench's would be.
 
-mod sim_bench;
-
 use kapitza_core::link::message::Telemetry;
 use kapitza_core::link::{Request, Response};
 use kapitza_core::math;
 use kapitza_core::simrig::Params;
-use sim_bench::Bench;
+use kapitza_test_support::sim_bench::Bench;
 
 /// The pendulum angle (degrees) in the first telemetry frame after 40 ms.
 fn theta_deg(p: Params, zero: u16, sign: i8) -> f64 {

@@ -8,9 +8,7 @@ use kapitza_core::link::{Request, Response};
 use kapitza_core::simrig::sensor::Line;
 use kapitza_core::simrig::Params;
 
-mod sim_bench;
-
-use sim_bench::Bench;
+use kapitza_test_support::sim_bench::Bench;
 
 #[test]
 fn a_healthy_bench_passes_and_starts() {

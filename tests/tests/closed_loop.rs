@@ -1,13 +1,12 @@
 //! Closed loop in virtual time: drive generator + phase lock + estimator + safety against the
-//! simulated pendulum and crank motor (`closed_loop_sim`), recovering φ0, ωp and R.
+//! simulated pendulum and crank motor (`kapitza_test_support::closed_loop`), recovering φ0, ωp
+//! and R.
 
-mod closed_loop_sim;
-
-use closed_loop_sim::Sim;
 use kapitza_core::model::{equilibria, DriveAngle, RMethod};
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::dds::omega_of_word;
 use kapitza_core::rig::safety::Request;
+use kapitza_test_support::closed_loop::Sim;
 
 /// One recovery case: drive strength, drive angle, start offset from φ0.
 struct Case {

@@ -1,15 +1,14 @@
-//! Closed-loop R in virtual time (`closed_loop_sim`): a stroke typed in 1.6 % short (12.5 mm
-//! for the true 12.7 mm) makes every R 3.2 % high open loop; with the loop on, the rig trims ω
-//! until the R it measures in situ is the one asked for, and off it returns to open loop.
+//! Closed-loop R in virtual time (`kapitza_test_support::closed_loop`): a stroke typed in 1.6 %
+//! short (12.5 mm for the true 12.7 mm) makes every R 3.2 % high open loop; with the loop on, the
+//! rig trims ω until the R it measures in situ is the one asked for, and off it returns to open
+//! loop.
 
-mod closed_loop_sim;
-
-use closed_loop_sim::Sim;
 use kapitza_core::math;
 use kapitza_core::rig::closed_loop::ClosedLoopR as Settings;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::dds::{omega_of_word, word_from_omega};
 use kapitza_core::rig::safety::Request;
+use kapitza_test_support::closed_loop::Sim;
 
 const TRUE_A: f64 = 0.0127;
 const R: f64 = 1.75;

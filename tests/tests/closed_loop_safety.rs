@@ -1,11 +1,9 @@
 //! Closed loop in virtual time: soft start, ramped change, soft stop, e-stop, link silence,
 //! stall and over-current, with the rig logic driving the simulated motor and pendulum.
 
-mod closed_loop_sim;
-
-use closed_loop_sim::Sim;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::safety::{Fault, Mode, Request, StopReason};
+use kapitza_test_support::closed_loop::Sim;
 
 fn sim() -> Sim {
     // Pendulum hanging, drive along 90°: the pendulum is irrelevant here, the motor is the point.

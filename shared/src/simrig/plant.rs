@@ -153,7 +153,7 @@ mod tests {
 
     #[test]
     fn at_constant_crank_speed_it_is_the_full_equation() {
-        // Also the closed-loop tests' plant (tests/tests/closed_loop_sim).
+        // Also the closed-loop tests' plant (kapitza_test_support::closed_loop).
         // physics §3: θ'' = −ω0² sin θ − (Aω²/ℓ) sin(θ − θd) cos ωt − cθ' when ψ = ωt, ψ' = ω,
         // ψ'' = 0 (the motor at its steady speed: duty = ω/K). Closed form, to rounding.
         let mut p = plant();

@@ -1,5 +1,4 @@
 //! The simulated rig behind its link, for tests that talk to it as the host does.
-#![allow(dead_code)] // each test file uses a part
 
 use kapitza_core::link::frame::{encode, receive_response, Header};
 use kapitza_core::link::message::Check;

@@ -5,8 +5,6 @@
 //! quantises to 14 bits after Gaussian noise (`kapitza_core::sim::noise`, seeded); the crank
 //! encoder to 4096 counts per turn.
 
-#![allow(dead_code)]
-
 use kapitza_core::integrate::{rk4_step, Stats};
 use kapitza_core::math;
 use kapitza_core::rig::config::RigConfig;

@@ -1,0 +1,9 @@
+//! What several kapitza test binaries share, as a library so each takes what it needs.
+//!
+//! | module | concept |
+//! |---|---|
+//! | [`sim_bench`] | the simulated rig behind its link, spoken to frame by frame as the host does |
+//! | [`closed_loop`] | the rig logic in virtual time against the simulated pendulum and motor, with a hand on the pendulum |
+
+pub mod closed_loop;
+pub mod sim_bench;
