@@ -1,12 +1,11 @@
 //! The real binary's exit statuses: 0 on success, 1 for a value out of range, 2 for bad syntax.
 
-use std::process::Command;
+use kapitza_test_support::binary::Binary;
+
+const KAPITZA: Binary = Binary(env!("CARGO_BIN_EXE_kapitza"));
 
 fn kapitza(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kapitza"))
-        .args(args)
-        .output()
-        .unwrap()
+    KAPITZA.run(args)
 }
 
 #[test]

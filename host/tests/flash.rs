@@ -3,15 +3,14 @@
 //! selection against a fake probe lister (none, several, no permission), and the version check
 //! after flashing against a simulated rig that speaks another protocol.
 
-use std::io::{BufRead, BufReader};
-use std::path::Path;
-use std::process::{Child, Command, Output, Stdio};
+use std::process::Output;
 use std::time::Duration;
 
 use clap::Parser;
 use kapitza::cli::{Cli, Command as Sub};
 use kapitza::flash::confirm;
 use kapitza::rig::{Exit, Failure};
+use kapitza_test_support::binary::Binary;
 use object::elf::{EM_ARM, EM_X86_64, ET_EXEC, PF_R, PF_W, PF_X, PT_LOAD};
 use object::write::elf::{FileHeader, ProgramHeader, Writer};
 use object::Endianness;
@@ -128,12 +127,10 @@ fn write_temp(dir: &tempfile::TempDir, name: &str, bytes: &[u8]) -> String {
     p.to_str().unwrap().to_string()
 }
 
+const KAPITZA: Binary = Binary(env!("CARGO_BIN_EXE_kapitza"));
+
 fn kapitza(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kapitza"))
-        .args(args)
-        .env_remove("KAPITZA_PORT")
-        .output()
-        .unwrap()
+    KAPITZA.run(args)
 }
 
 fn stderr(o: &Output) -> String {
@@ -442,47 +439,17 @@ fn probes_lists_selectors_and_permission() {
 
 // ---- after flashing: the version check, against `kapitza rig serve` ----------------------
 
-/// `kapitza rig serve` on a pseudo-terminal; killed when dropped.
-struct Served(Child, String);
-
-impl Drop for Served {
-    fn drop(&mut self) {
-        // SAFETY: kill(2) on our own child's pid; SIGINT lets it remove its symlink.
-        unsafe { libc::kill(self.0.id() as i32, libc::SIGINT) };
-        std::thread::sleep(Duration::from_millis(200));
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn serve(extra: &[&str]) -> Served {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_kapitza"))
-        .args(["rig", "serve", "--speed", "20"])
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let path = line.trim().to_string();
-    assert!(Path::new(&path).exists(), "device path: {path:?}");
-    Served(child, path)
-}
-
 #[test]
 fn the_version_is_confirmed_after_flashing() {
-    let rig = serve(&[]);
-    let s = confirm::confirm(&rig.1, Duration::from_secs(10)).unwrap();
+    let rig = KAPITZA.serve("20", &[]);
+    let s = confirm::confirm(&rig.first_line, Duration::from_secs(10)).unwrap();
     assert_eq!(s.version.protocol, kapitza_core::link::PROTOCOL_VERSION);
 }
 
 #[test]
 fn a_version_mismatch_after_flashing_is_an_error() {
-    let rig = serve(&["--protocol", "9"]);
-    let Err(e) = confirm::confirm(&rig.1, Duration::from_secs(10)) else {
+    let rig = KAPITZA.serve("20", &["--protocol", "9"]);
+    let Err(e) = confirm::confirm(&rig.first_line, Duration::from_secs(10)) else {
         panic!("protocol v9 was accepted");
     };
     let msg = format!("{e:#}");

@@ -2,107 +2,29 @@
 //! process, `set`, `status`, `attach` in others. Simulated time runs fast (`--speed 20`), and the
 //! deadlines are generous: these are not timed tests.
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Child, Command, Output, Stdio};
+use std::io::{Read, Write};
+use std::process::Output;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use kapitza_test_support::binary::{json, Binary, Running};
 use serde_json::Value;
 use serialport::SerialPort;
 
+const KAPITZA: Binary = Binary(env!("CARGO_BIN_EXE_kapitza"));
+
 fn kapitza(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kapitza"))
-        .args(args)
-        .env_remove("KAPITZA_PORT")
-        .output()
-        .unwrap()
-}
-
-fn json(o: &Output) -> Value {
-    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| {
-        panic!(
-            "{e}: {}\n{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        )
-    })
-}
-
-/// A running `kapitza <args>` whose first stdout line has been read; killed when dropped.
-struct Running {
-    child: Child,
-    first_line: String,
-    rest: std::thread::JoinHandle<String>,
+    KAPITZA.run(args)
 }
 
 fn start(args: &[&str]) -> Running {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_kapitza"))
-        .args(args)
-        .env_remove("KAPITZA_PORT")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut first_line = String::new();
-    out.read_line(&mut first_line).unwrap();
-    let rest = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = out.read_to_string(&mut s);
-        s
-    });
-    Running {
-        child,
-        first_line: first_line.trim().to_string(),
-        rest,
-    }
+    KAPITZA.start(args)
 }
 
-impl Running {
-    /// Stops it (SIGINT, as Ctrl-C) and returns what it printed after the first line.
-    fn interrupt(mut self) -> String {
-        // SAFETY: kill(2) on our own child's pid.
-        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
-        let _ = self.child.wait();
-        std::mem::replace(&mut self.rest, std::thread::spawn(String::new))
-            .join()
-            .unwrap()
-    }
-}
-
-impl Drop for Running {
-    /// Ctrl-C first, so a server removes its symlink and an owner its socket; then a kill.
-    fn drop(&mut self) {
-        // SAFETY: kill(2) on our own child's pid.
-        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
-        let deadline = Instant::now() + Duration::from_secs(2);
-        while Instant::now() < deadline {
-            if let Ok(Some(_)) = self.child.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
+/// A simulated rig at 20 times real time.
 fn serve(extra: &[&str]) -> Running {
-    serve_at("20", extra)
-}
-
-/// A simulated rig at `speed` times real time.
-fn serve_at(speed: &str, extra: &[&str]) -> Running {
-    let mut args = vec!["rig", "serve", "--speed", speed];
-    args.extend_from_slice(extra);
-    let r = start(&args);
-    assert!(
-        r.first_line.starts_with('/'),
-        "device path: {:?}",
-        r.first_line
-    );
-    r
+    KAPITZA.serve("20", extra)
 }
 
 /// The full equation's period-mean rest angle (degrees) for the demo rod at ω, θd = 90°, from

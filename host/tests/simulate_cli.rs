@@ -4,17 +4,18 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use kapitza_test_support::binary::Binary;
+
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/data")
         .join(name)
 }
 
+const KAPITZA: Binary = Binary(env!("CARGO_BIN_EXE_kapitza"));
+
 fn kapitza(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kapitza"))
-        .args(args)
-        .output()
-        .unwrap()
+    KAPITZA.run(args)
 }
 
 fn text(b: &[u8]) -> String {
