@@ -114,6 +114,11 @@ fn errors_fall_as_evaluations_rise() {
 #[test]
 fn json_has_the_documented_keys() {
     let (v, _) = quick();
+    // docs/cli.md lists exactly the keys printed (kapitza_test_support::cli_doc).
+    kapitza_test_support::cli_doc::assert_documented(
+        "`kapitza bench --json`",
+        std::slice::from_ref(v),
+    );
     assert_eq!(v["quick"], true);
     let scenes: Vec<&str> = arr(&v["scenes"])
         .iter()
