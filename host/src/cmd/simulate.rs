@@ -97,7 +97,8 @@ pub struct Summary {
     /// The scene's `[expect]` with `met`; `null` when the scene has none.
     pub expect: Option<Judged>,
     pub fidelity: FidelityOut,
-    /// `"dop853"` or `"rk4"`.
+    /// `"dop853"`, `"rkn86"` or `"rkn1210"` (with `rtol`, `atol`); `"rk4"`, `"verlet"`,
+    /// `"yoshida4"` or `"yoshida6"` (with `steps_per_period`).
     pub method: &'static str,
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
