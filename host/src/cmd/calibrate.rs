@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use serde::Serialize;
 
+use super::progress::progress_writer;
 use super::rig_args::RigArgs;
 use crate::calibrate::operator::Operator;
 use crate::calibrate::steps::Calibrator;
@@ -65,11 +66,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     std::fs::write(&backup, super::config::to_toml(&s.config)?)
         .with_context(|| format!("cannot save the configuration to {}", backup.display()))?;
     let restore = format!("kapitza config set {}", backup.display());
-    let mut progress: Box<dyn Write> = if args.json {
-        Box::new(std::io::stderr())
-    } else {
-        Box::new(&mut *out)
-    };
+    let mut progress = progress_writer(args.json, &mut *out);
     writeln!(
         progress,
         "{name}: the configuration it had is saved to {} (restore: `{restore}`)",

@@ -12,6 +12,7 @@ pub mod monitor;
 pub mod ports;
 pub mod predict;
 pub mod probes;
+pub mod progress;
 pub mod rig_args;
 pub mod rig_serve;
 pub mod set;

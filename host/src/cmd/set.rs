@@ -15,6 +15,7 @@ use anyhow::{bail, Result};
 use kapitza_core::link::message::{Check, Mode};
 use kapitza_core::link::Telemetry;
 
+use super::progress::progress_writer;
 use super::rig_args::RigArgs;
 use crate::link::{Error, LineError};
 use crate::rig::session::{line_failure, Session, StatusView};
@@ -99,11 +100,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         }
     }
     let after = s.call(|c| c.status())?.counters.commands;
-    let mut progress: Box<dyn Write> = if args.json {
-        Box::new(std::io::stderr())
-    } else {
-        Box::new(&mut *out)
-    };
+    let mut progress = progress_writer(args.json, &mut *out);
     writeln!(
         progress,
         "{}: R = {} at θd = {}° taken",
