@@ -6,7 +6,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 use std::io::Write;
 
-use super::options::{write_csv, Output, Range};
+use super::options::{drive_strengths, write_csv, Output, Range};
 use crate::chart::draw::{self, pe, tint, Figure, SERIES};
 use crate::chart::map::samples;
 use crate::input::{self, GeometryArgs};
@@ -84,12 +84,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let dir = args.output.prepare()?;
     let rs = match input::drive_groups(&args.geometry, args.amplitude, args.omega, args.gravity)? {
         Some(g) => vec![g.r],
-        None => {
-            for &r in &args.r {
-                input::non_negative("--r", r)?;
-            }
-            args.r.clone()
-        }
+        None => drive_strengths(&args.r)?,
     };
     if !(2..=20_000).contains(&args.samples) {
         bail!(

@@ -1,4 +1,5 @@
-//! Command-line pieces every chart shares: ranges, grid sizes, the output directory.
+//! Command-line pieces every chart shares: ranges, grid sizes, drive strengths, the output
+//! directory.
 
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -80,6 +81,15 @@ impl std::str::FromStr for Point {
             y: finite(b, s)?,
         })
     }
+}
+
+/// The drive strengths of `--r R,…`, each checked: a negative or non-finite one is refused
+/// naming `--r` (exit status 1, like every out-of-range value).
+pub fn drive_strengths(rs: &[f64]) -> Result<Vec<f64>> {
+    for &r in rs {
+        crate::input::non_negative("--r", r)?;
+    }
+    Ok(rs.to_vec())
 }
 
 /// Where the files go and whether JSON goes to stdout.

@@ -7,10 +7,9 @@ use plotters::prelude::*;
 use serde::Serialize;
 use std::io::Write;
 
-use super::options::{csv_num, write_csv, Output, Range, Size};
+use super::options::{csv_num, drive_strengths, write_csv, Output, Range, Size};
 use crate::chart::draw::{self, pe, tint, Figure, SERIES};
 use crate::chart::map::samples;
-use crate::input;
 use kapitza_core::model::equilibria::saddle_node_r;
 use kapitza_core::model::{equilibria, DriveAngle};
 
@@ -116,9 +115,7 @@ pub fn band(r: f64) -> Result<Band> {
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let dir = args.output.prepare()?;
-    for &r in &args.r {
-        input::non_negative("--r", r)?;
-    }
+    let strengths = drive_strengths(&args.r)?;
     if args.r_range.from < 0.0 {
         bail!("--r-range must start at 0 or above");
     }
@@ -136,8 +133,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
             });
         }
     }
-    let bands = args
-        .r
+    let bands = strengths
         .iter()
         .map(|&r| band(r))
         .collect::<Result<Vec<_>>>()?;
