@@ -96,6 +96,25 @@ pub fn margin(r: f64, theta_d: DriveAngle, phi: f64) -> f64 {
 }
 
 /// All equilibria of the averaged motion for drive strength 0 ≤ R ≤ [`R_MAX`] at drive angle θd.
+///
+/// A horizontal drive (θd = 90°) factors the condition: f(φ) = sin φ (1 − R cos φ), so above
+/// R = 1 the rod rests at ±arccos(1/R) with margin s = R − 1/R, and hanging and inverted are
+/// unstable (physics §3):
+///
+/// ```
+/// use kapitza_core::model::{equilibria, DriveAngle};
+///
+/// let r = 1.75;
+/// let eq = equilibria(r, DriveAngle::from_deg(90.0)?)?;
+/// assert_eq!(eq.len(), 4);
+/// assert_eq!(eq.stable().count(), 2);
+/// // Of the two, the one on the drive's side: +arccos(1/R) = 55.15°.
+/// let rest = eq.stable().find(|e| e.within_90_of_drive).unwrap();
+/// // Tolerance: rounding of the closed-form roots (the root finder is exact for this f).
+/// assert!((rest.angle - (1.0 / r).acos()).abs() < 1e-12);
+/// assert!((rest.margin - (r - 1.0 / r)).abs() < 1e-12);
+/// # Ok::<(), kapitza_core::ParamError>(())
+/// ```
 pub fn equilibria(r: f64, theta_d: DriveAngle) -> Result<Equilibria, ParamError> {
     let r = non_negative("R", r)?;
     if r > R_MAX {

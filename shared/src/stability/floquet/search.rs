@@ -254,6 +254,21 @@ pub const NOT_FLUTTER: &str = "the window ends at tr M = +2, not at a period-2 (
 pub const TRACE_NOT_REACHED: &str = "tr M does not pass 2 cos(2π/n) inside the window";
 
 /// [`Floquet::window`] with the defaults ([`super::DEFAULT_STEPS`], scan step and limit).
+///
+/// The inverted window opens where the characteristic value a0(q) of Mathieu's equation equals
+/// a = 4k (q = 2m, physics §4). At q = 1, a0 = −0.4551386634 (Abramowitz & Stegun, table
+/// 20.1), so at k = a0/4 the window's lower end is m = 0.5:
+///
+/// ```
+/// use kapitza_core::stability::floquet;
+///
+/// let k = -0.455_138_663_4 / 4.0;
+/// let w = floquet::window(k, 0.0, 1e-9)?.value;
+/// let lower = w.lower.value().unwrap();
+/// // Tolerance: the table's ten digits carry into m at about 1e-10; 1e-7 covers the search.
+/// assert!((lower - 0.5).abs() < 1e-7, "{lower}");
+/// # Ok::<(), kapitza_core::ParamError>(())
+/// ```
 pub fn window(k: f64, delta: f64, tol: f64) -> Result<Measured<Window>, ParamError> {
     Floquet::default().window(k, delta, tol)
 }
