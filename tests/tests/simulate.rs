@@ -96,8 +96,8 @@ fn json_has_the_documented_keys() {
 fn averaged_rod_rests_at_the_predicted_equilibrium() {
     // R = 3 at θd = 135°, start 100°: the averaged theory's stable equilibrium within 90° of the
     // drive is 116.728° (kapitza predict --r 3 --angle 135, the root of
-    // sin φ + (R/2) sin 2(φ − θd) = 0, physics §3). The averaged run converges to it exactly, so the
-    // classifier's resolution is the tolerance.
+    // sin φ + (R/2) sin 2(φ − θd) = 0, physics §3). The averaged run converges to it exactly, so
+    // the classifier's resolution is the tolerance.
     let v = simulate("sim_averaged_rest.toml", &[]);
     assert_eq!(v["outcome"]["kind"], "rest");
     let got = f(&v, "/outcome/angle_deg");

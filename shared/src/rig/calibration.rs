@@ -8,9 +8,8 @@
 //! current   I = (counts − offset) · scale        A; counts from the 12-bit ADC
 //! servo     pulse = (min + max)/2 + (θd − centre)·(max − min)/range     µs (rig::servo)
 //! ```
-//! [`Calibration::DEFAULT`] is what the reference board was built with before these were
-//! settings: a stored configuration of the first record format loads with it
-//! ([`crate::persist`]).
+//! [`Calibration::DEFAULT`] is the reference board as wired: a stored configuration of the first
+//! record format, which has no calibration, loads with it ([`crate::persist`]).
 
 use super::config::too_big as bad;
 use super::estimator::Tuning;
@@ -147,8 +146,8 @@ const SERVO_MIN_US: u32 = 400;
 const SERVO_MAX_US: u32 = 2600;
 
 /// ADC counts → amperes in integers: `(counts − offset)·scale`, offset in Q8 counts and the
-/// scale in Q24 A a count, so the reference board's 77/65536 A a count is exact and gives the
-/// same bits as before it was a setting.
+/// scale in Q24 A a count, so the reference board's 77/65536 A a count is exact and a record of
+/// the first format, which fixed that scale, reads the same currents to the bit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CurrentSense {
     offset_q8: i64,

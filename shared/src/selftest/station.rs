@@ -46,9 +46,9 @@ fn frame(seq: u8, req: &Request, d: &mut [u8; MAX_REQUEST_FRAME]) -> usize {
 }
 
 /// A conversation with the reference rig through its rig loop: version, a drive (after its
-/// pre-run check), telemetry,
-/// a damaged frame, a refused drive, the same configuration again, a stop — 8 s of samples at
-/// 10 kHz with a synthetic pendulum; the digest covers every byte the loop sends.
+/// pre-run check), telemetry, a damaged frame, a refused drive, the same configuration again, a
+/// stop — 8 s of samples at 10 kHz with a synthetic pendulum; the digest covers every byte the
+/// loop sends.
 fn rig_loop_conversation() -> u64 {
     let cfg = RigConfig::REFERENCE;
     let mut rig = RigLoop::new(

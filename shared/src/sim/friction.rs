@@ -17,9 +17,9 @@
 //!          have g > 0 but that dips below zero between them (a double crossing) is caught
 //! ```
 //! The first probe with g ≤ 0 ends the search, and the reversal is bisected between it and the
-//! probe before it. Under a strong drive θ'
-//! (which includes the fast wobble) changes sign twice a period and friction acts like weak
-//! damping; sticking needs φ near θd or a weak drive (physics §5).
+//! probe before it. Under a strong drive θ' (which includes the fast wobble) changes sign twice a
+//! period and friction acts like weak damping; sticking needs φ near θd or a weak drive
+//! (physics §5).
 
 use super::eom::{FullEom, NoExtra, Sliding};
 use super::run::{Context, Dense, Method, RunOut, SimError};

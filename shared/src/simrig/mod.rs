@@ -91,8 +91,8 @@ pub struct Params {
 
 impl Params {
     /// The demo rod of physics §4 (L = 0.25 m, A = 12.7 mm), damped to Q = 10 (c = ω0/Q with
-    /// ω0 = √(3g/2L) = 7.672 rad/s), on the
-    /// default motor, a quiet sensor (0.02°) and a fast servo, hanging at rest.
+    /// ω0 = √(3g/2L) = 7.672 rad/s), on the default motor, a quiet sensor (0.02°) and a fast
+    /// servo, hanging at rest.
     pub const DEMO: Self = Self {
         geometry: Geometry::Rod { length: 0.25 },
         gravity: 9.81,
