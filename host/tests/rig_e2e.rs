@@ -649,8 +649,9 @@ fn calibration_recovers_the_mistyped_rig_and_fixes_its_settle_angle() {
     );
     assert_eq!(wrote(&v, "sensor", "pendulum_sign"), 1.0);
     assert_eq!(wrote(&v, "crank", "crank_sign"), 1.0);
-    // The lean gives the mount to about half a degree (calib::plumb: the zero and the averaged
-    // model), which moves the settle angle at R = 1.75 by less than 0.2°.
+    // The lean gives the mount to about half a degree: the slider-crank's harmonic leans the
+    // pendulum 0.4° further than the averaged model of calib::plumb knows
+    // (shared/tests/calib_settle_angle.rs), which moves the settle angle at R = 1.75 by 0.2°.
     assert!((mount - 92.0).abs() < 0.5, "mount {mount}");
 
     let (after, model_after, omega) = settle_at_1_75(port);
@@ -665,10 +666,13 @@ fn calibration_recovers_the_mistyped_rig_and_fixes_its_settle_angle() {
          {full:.2}°)"
     );
     assert!((before - model).abs() > 1.5, "before {before} vs {model}");
-    // The goal is 0.5°; measured here: 0.9° on the mirror branch (issue 15's note has the
-    // figures). The bound holds what is reached, and that it is several times closer.
+    // Issue 15's goal is 0.5°. Measured (docs/calibration.md): 0.35°–0.38° when it settles on
+    // the negative branch, 0.52° on the positive one. What remains is the slider-crank's
+    // second harmonic, which the configuration cannot describe (shared/tests/
+    // calib_settle_angle.rs): +0.74° and +0.15° of settle angle by branch, and the mount 0.4°
+    // high from the lean it adds, −0.2° and +0.2°. The bound holds what is reached.
     assert!(
-        (after.abs() - full).abs() < 1.2,
+        (after.abs() - full).abs() < 0.6,
         "after {after} vs full {full}"
     );
     assert!((after.abs() - full).abs() < (before - model).abs() / 2.0);

@@ -276,6 +276,32 @@ fn the_servo_pulse_comes_from_the_configured_map() {
 }
 
 #[test]
+fn a_new_servo_map_moves_the_mount_where_theta_d_holds() {
+    // Calibration corrects the map while θd stays where it was (the stroke step leaves it at
+    // 90°, and `set --angle 90` asks for 90° again): the pulse for the same θd through the new
+    // map is sent at once. REFERENCE: 7.407 µs a degree about 1500 µs at 90°; the centre moved
+    // 2.5° the other way is 2.5 · 2000/270 = 18.52 µs lower at θd = 0°.
+    let mut b = Bench::new(ConfigOrigin::Stored);
+    b.run_ms(2);
+    let first: Vec<f64> = b.ticks.iter().filter_map(|t| t.servo_us).collect();
+    assert_eq!(first.len(), 1);
+    let mut cfg = CFG;
+    cfg.calibration.servo.centre_deg += 2.5;
+    b.ticks.clear();
+    b.send(1, &Request::SetConfig(cfg.into()));
+    b.run_ms(2);
+    assert_eq!(b.drain()[0], (1, Response::Ok));
+    let us: Vec<f64> = b.ticks.iter().filter_map(|t| t.servo_us).collect();
+    assert_eq!(us.len(), 1, "{us:?}");
+    assert!(
+        (first[0] - us[0] - 2.5 * 2000.0 / 270.0).abs() < 1e-9,
+        "{first:?} {us:?}"
+    );
+    let deg: Vec<f64> = b.ticks.iter().filter_map(|t| t.servo_deg).collect();
+    assert!(deg[0].abs() < 1e-7, "{deg:?}");
+}
+
+#[test]
 fn the_same_configuration_is_not_stored_again() {
     let mut b = Bench::new(ConfigOrigin::Stored);
     b.send(1, &Request::SetConfig(CFG.into()));

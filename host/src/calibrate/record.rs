@@ -46,6 +46,16 @@ pub fn raw(s: &mut Session, secs: f64) -> Result<Vec<(f64, RawTelemetry)>> {
     Ok(stream(s, secs, |c| c.raw_telemetry(), |_, _| false)?.0)
 }
 
+/// Raw telemetry until `done` says so (given each frame and the rig seconds since the first), or
+/// until `secs` of rig time have passed; the flag says which.
+pub fn raw_until(
+    s: &mut Session,
+    secs: f64,
+    done: impl FnMut(&RawTelemetry, f64) -> bool,
+) -> Result<(Vec<(f64, RawTelemetry)>, bool)> {
+    stream(s, secs, |c| c.raw_telemetry(), done)
+}
+
 /// Telemetry until `done` says so (given each frame and the rig seconds since the first), or
 /// until `secs` of rig time have passed; the flag says which.
 pub fn telemetry(

@@ -31,6 +31,9 @@ const PULSE_COUNTS: i64 = 50;
 /// Current readings at rest (s), and what a healthy sense reads with the bridge off: within
 /// 10 % of the 12-bit scale of zero, scattered by a few counts.
 const REST_S: f64 = 1.0;
+/// How long (rig seconds) a crank still coasting from the crank step may take to stop: the
+/// bridge is awake in bring-up mode, so a turning motor drives current through it.
+const SPIN_DOWN_S: f64 = 3.0;
 const CURRENT_LIMITS: current::Limits = current::Limits {
     min: 0.0,
     max: 410.0,
@@ -233,8 +236,22 @@ impl<'a> Calibrator<'a> {
         let deg = self.theta_d_now()?;
         self.s.call(|c| c.stream_telemetry(20))?;
         self.s.call(|c| c.bring_up(0.0, deg))?;
-        let frames = record::raw(&mut self.s, REST_S)?;
-        let readings: Vec<f64> = frames.iter().map(|(_, f)| f64::from(f.current)).collect();
+        // At rest: from the first frame after which the crank encoder stood still for REST_S.
+        let mut still: Option<(u32, f64)> = None;
+        let (frames, _) =
+            record::raw_until(&mut self.s, REST_S + SPIN_DOWN_S, |f, t| match still {
+                Some((crank, since)) if crank == f.crank => t - since >= REST_S,
+                _ => {
+                    still = Some((f.crank, t));
+                    false
+                }
+            })?;
+        let since = still.map_or(0.0, |(_, since)| since);
+        let readings: Vec<f64> = frames
+            .iter()
+            .filter(|(t, _)| *t >= since)
+            .map(|(_, f)| f64::from(f.current))
+            .collect();
         let off = current::offset(&readings, &CURRENT_LIMITS).map_err(|e| {
             let _ = self.s.call(|c| c.stop());
             refused(Step::Servo, e)

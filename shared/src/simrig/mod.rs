@@ -300,6 +300,12 @@ impl SimRig {
         &self.rig
     }
 
+    /// The pendulum's true angle (rad from hanging) and the mount's true drive angle (rad): what
+    /// the sensor and the servo map only approximate, for tests that judge the rig's read-out.
+    pub fn truth(&self) -> (f64, f64) {
+        (self.y[0], self.plant.theta_d)
+    }
+
     pub fn counters(&self) -> &Counters {
         self.rig.counters()
     }

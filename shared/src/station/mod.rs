@@ -58,6 +58,7 @@ use crate::rig::estop::EStop;
 use crate::rig::fixed::{elapsed_us, Amps, Angle};
 use crate::rig::phase_lock::Motor;
 use crate::rig::safety::Mode;
+use crate::rig::servo::ServoMap;
 use drive::{Calibrated, Drive};
 use precheck::{SensorView, Step};
 use serve::{apply, Activity, Clock, Effect, RigServer};
@@ -94,7 +95,8 @@ pub struct Tick {
     /// The H-bridge may be awake: only while the drive runs or ramps down, the pre-run
     /// check pulses, or bring-up mode drives.
     pub bridge: bool,
-    /// θd moved: the servo's new position, degrees along the mount's travel.
+    /// θd moved, or the servo's map changed: the servo's new position, degrees along the
+    /// mount's travel.
     pub servo_deg: Option<f64>,
     /// The same as the servo's pulse width (µs, unrounded), through the calibrated map.
     pub servo_us: Option<f64>,
@@ -166,7 +168,8 @@ pub struct RigLoop {
     /// The e-stop line at the last control tick, debounced.
     estop: bool,
     estop_line: EStop,
-    servo: Option<Angle>,
+    /// The θd and the servo map of the last pulse sent: a new map (calibration) resends it.
+    servo: Option<(Angle, ServoMap)>,
     store: Option<RigConfig>,
     last: Sample,
     uptime_us: u64,
@@ -270,8 +273,9 @@ impl RigLoop {
         self.current = m.current;
         self.raw_crank = m.raw_crank;
         self.counts = m.counts;
-        let servo_deg = (self.servo != Some(report.theta_d)).then(|| {
-            self.servo = Some(report.theta_d);
+        let told = Some((report.theta_d, cal.servo));
+        let servo_deg = (self.servo != told).then(|| {
+            self.servo = told;
             crate::link::convert::deg_along_travel(
                 report.theta_d,
                 self.srv.cfg.limits.drive_angle_min_deg,
