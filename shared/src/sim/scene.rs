@@ -154,6 +154,31 @@ fn pendulum_key(name: &str) -> &'static str {
 }
 
 impl Scene {
+    /// A canonical scene from its numbers, run for `length` on the given equation.
+    pub fn from_case(
+        c: &crate::cases::SceneCase,
+        length: RunLength,
+        fidelity: Fidelity,
+    ) -> Result<Scene, crate::error::ParamError> {
+        Ok(Scene {
+            pendulum: Geometry::rod(c.rod_length)?,
+            drive: DriveSpec {
+                amplitude: c.amplitude,
+                frequency: DriveFrequency::Omega(c.omega),
+                angle: DriveAngle::from_deg(c.drive_angle_deg)?,
+            },
+            gravity: c.gravity,
+            initial_angle: crate::math::to_rad(c.initial_angle_deg),
+            initial_rate: c.initial_rate,
+            length,
+            fidelity: FidelityChoice::Fixed(fidelity),
+            effects: Effects {
+                viscous: Some(Viscous::Q(c.q)),
+                ..Effects::default()
+            },
+        })
+    }
+
     /// Checks every number once; nothing runs on a scene that fails.
     pub fn check(&self) -> Result<(), SceneError> {
         let d = &self.drive;
