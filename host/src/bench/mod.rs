@@ -360,7 +360,7 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
                         "{}: {} {} at {} steps per period (≈ {predicted:.1e} evaluations, over the budget of {:.0e})",
                         s.name,
                         family.label(),
-                        measure::format_name(*format),
+                        format,
                         setting,
                         plan.max_evals
                     ));
@@ -411,12 +411,7 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
     let mut failed: Vec<(String, String, Vec<f64>, String)> = Vec::new();
     for (i, family, format, setting) in jobs {
         let s = &scenes[i];
-        let what = format!(
-            "{}: {} {} at {setting}",
-            s.name,
-            family.label(),
-            measure::format_name(format)
-        );
+        let what = format!("{}: {} {} at {setting}", s.name, family.label(), format);
         let got = if family.is_peer() {
             peer::peer(s, &references[i], family, setting, plan.batch, &mut notes)
         } else {
@@ -434,7 +429,7 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
         match got {
             Ok(p) => points.push(p),
             Err(e) => {
-                let method = ratio::curve_label(family, measure::format_name(format));
+                let method = ratio::curve_label(family, format);
                 match failed.iter_mut().find(|f| f.0 == s.name && f.1 == method) {
                     Some(f) => f.2.push(setting),
                     None => {

@@ -37,7 +37,7 @@ use super::scenes::BenchScene;
 use kapitza_core::integrate::System;
 use kapitza_core::sim::eom::{FullEom, NoExtra, Viscous};
 use kapitza_core::sim::signal::Steady;
-use kapitza_core::sim::Scene;
+use kapitza_core::sim::{Format, Scene};
 
 /// Counts evaluations, or not.
 trait Tally {
@@ -272,10 +272,10 @@ pub fn peer(
     Ok(Point {
         scene: s.name.to_string(),
         family,
-        who: "peer",
-        fidelity: "full",
-        format: "f64",
-        setting_name: "rtol",
+        who: family.who(),
+        fidelity: family.fidelity(),
+        format: Format::F64,
+        setting_name: family.setting_name(),
         setting: tol,
         error: err,
         wall_s: cost.wall_s,

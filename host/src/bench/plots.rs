@@ -13,6 +13,8 @@ use std::path::Path;
 use super::measure::{Family, Point};
 use super::ratio::{curve_label, curves};
 use super::{Results, TARGETS};
+use kapitza_core::sim::Format;
+use kapitza_core::stability::Criterion;
 
 const FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 const SIZE: (u32, u32) = (1280, 760);
@@ -248,7 +250,7 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
             .collect();
         let mark = if family.is_peer() {
             Mark::Triangle
-        } else if *format == "f32" {
+        } else if *format == Format::F32 {
             Mark::Dashed
         } else {
             Mark::Solid
@@ -279,7 +281,7 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
                     .map_err(e)?;
             }
         }
-        entries.push((curve_label(*family, format), c, mark));
+        entries.push((curve_label(*family, *format), c, mark));
     }
     let notes = vec![
         "grey dashes: target errors 1e-6, 1e-9".to_string(),
@@ -296,25 +298,14 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
     Ok(())
 }
 
-fn criterion_colour(name: &str) -> RGBColor {
-    match name {
-        "averaging" => RGBColor(255, 127, 14),
-        "mathieu" => RGBColor(31, 119, 180),
-        "harmonic_balance" => RGBColor(44, 160, 44),
-        _ => RGBColor(0, 0, 0),
+fn criterion_colour(c: Criterion) -> RGBColor {
+    match c {
+        Criterion::Averaging => RGBColor(255, 127, 14),
+        Criterion::Mathieu => RGBColor(31, 119, 180),
+        Criterion::HarmonicBalance => RGBColor(44, 160, 44),
+        Criterion::Floquet => RGBColor(0, 0, 0),
     }
 }
-
-fn criterion_label(name: &str) -> &'static str {
-    match name {
-        "averaging" => "averaging",
-        "mathieu" => "Mathieu series",
-        "harmonic_balance" => "harmonic balance",
-        _ => "Floquet",
-    }
-}
-
-const CRITERIA: [&str; 3] = ["averaging", "mathieu", "harmonic_balance"];
 
 /// Each cheaper criterion's error against Floquet as k varies.
 pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
@@ -322,7 +313,7 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
     let rows: Vec<_> = r
         .stability_criteria
         .iter()
-        .filter(|c| c.criterion != "floquet")
+        .filter(|c| c.criterion != Criterion::Floquet)
         .collect();
     let (y0, y1) = log_range(rows.iter().filter_map(|c| c.error), 3.0);
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
@@ -353,7 +344,7 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
         .draw()
         .map_err(e)?;
     let mut entries = Vec::new();
-    for name in CRITERIA {
+    for name in Criterion::CHEAPER {
         let c = criterion_colour(name);
         for inverted in [true, false] {
             let pts: Vec<_> = rows
@@ -383,7 +374,7 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
                 }
             }
         }
-        entries.push((criterion_label(name).to_string(), c, Mark::Solid));
+        entries.push((name.label().to_string(), c, Mark::Solid));
     }
     legend(
         &right,
@@ -409,7 +400,7 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
     let rows: Vec<_> = r
         .stability_criteria
         .iter()
-        .filter(|c| c.criterion != "floquet" && c.error.is_some_and(|x| x > 0.0))
+        .filter(|c| c.criterion != Criterion::Floquet && c.error.is_some_and(|x| x > 0.0))
         .collect();
     let fl = &r.floquet_convergence;
     let (x0, x1) = log_range(
@@ -453,7 +444,7 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
         .draw()
         .map_err(e)?;
     let mut entries = Vec::new();
-    for name in CRITERIA {
+    for name in Criterion::CHEAPER {
         let c = criterion_colour(name);
         chart
             .draw_series(rows.iter().filter(|r| r.criterion == name).filter_map(|r| {
@@ -461,7 +452,7 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
                     .map(|x| Circle::new((r.seconds_per_eval, x), 5, c.filled()))
             }))
             .map_err(e)?;
-        entries.push((criterion_label(name).to_string(), c, Mark::Dot));
+        entries.push((name.label().to_string(), c, Mark::Dot));
     }
     let mut ks: Vec<f64> = fl.iter().map(|f| f.k).collect();
     ks.dedup();

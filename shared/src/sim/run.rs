@@ -27,6 +27,7 @@ use crate::integrate::{
 };
 use crate::{math, Real};
 use core::fmt;
+use serde::Serialize;
 
 /// How to integrate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,7 +72,8 @@ impl Method {
 }
 
 /// How an adaptive method picks its next step from its error estimates.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Controller {
     /// From the last error alone (h ∝ err^(−1/(q+1))).
     #[default]
@@ -90,13 +92,44 @@ impl Controller {
             Controller::Pi => Self::PI_BETA,
         }
     }
+
+    /// As scene files spell it (`run.controller`): `standard`, `pi`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Controller::Standard => "standard",
+            Controller::Pi => "pi",
+        }
+    }
+}
+
+impl fmt::Display for Controller {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// The number format of the state and its arithmetic.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Format {
     F64,
     F32,
+}
+
+impl Format {
+    /// As scene files spell it (`run.format`): `f64`, `f32`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::F64 => "f64",
+            Format::F32 => "f32",
+        }
+    }
+}
+
+impl fmt::Display for Format {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// How to run a scene.
@@ -143,11 +176,29 @@ pub struct Report {
     pub work: Stats,
     /// Work of the Lyapunov run, when the classifier needed one.
     pub lyapunov_work: Stats,
-    /// Final time, angle (rad, unwrapped) and rate (rad/s). From the averaged model: the full
-    /// state read back from the slow one ([`super::wobble`]).
-    pub end: (f64, f64, f64),
+    /// Where the run ended. From the averaged model: the full state read back from the slow one
+    /// ([`super::wobble`]).
+    pub end: EndState,
     /// With Coulomb friction: how many times the pendulum stuck.
     pub sticks: Option<u64>,
+}
+
+/// The state at the end of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EndState {
+    /// Time (s).
+    pub t: f64,
+    /// Angle (rad), unwrapped: whole turns included.
+    pub theta: f64,
+    /// Rate (rad/s).
+    pub rate: f64,
+}
+
+impl EndState {
+    /// (θ, θ') without the time.
+    pub fn angle_rate(&self) -> (f64, f64) {
+        (self.theta, self.rate)
+    }
 }
 
 /// Why a run did not happen or did not finish.
@@ -238,7 +289,7 @@ impl Context {
 pub(super) struct RunOut<'a, Rec: Recorder> {
     pub sampler: Sampler<'a, Rec>,
     pub work: Stats,
-    pub end: (f64, f64, f64),
+    pub end: EndState,
     pub sticks: Option<u64>,
 }
 
@@ -424,7 +475,11 @@ fn run_format<R: Real, Rec: Recorder>(
     // The end state is reported as the full one: the slow state with its wobble put back, at
     // the drive's phase and frequency there.
     if let Some(w) = wobble {
-        let (t, phi, phi_rate) = report.end;
+        let EndState {
+            t,
+            theta: phi,
+            rate: phi_rate,
+        } = report.end;
         let drive = sched.state(t);
         if drive.omega <= 0.0 {
             return Ok(report);
@@ -434,7 +489,7 @@ fn run_format<R: Real, Rec: Recorder>(
             ..w
         };
         let (theta, rate) = w.full((phi, phi_rate), drive.phase);
-        report.end = (t, theta, rate);
+        report.end = EndState { t, theta, rate };
     }
     Ok(report)
 }
@@ -682,7 +737,11 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             return Err(SimError::Integrate(IntegrateError::NonFinite { t }));
         }
     }
-    let end = (t, y[0].to_f64() + turns.offset(), y[1].to_f64());
+    let end = EndState {
+        t,
+        theta: y[0].to_f64() + turns.offset(),
+        rate: y[1].to_f64(),
+    };
     Ok(RunOut {
         sampler,
         work,

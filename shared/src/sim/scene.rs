@@ -5,6 +5,7 @@
 
 use crate::model::{DriveAngle, Geometry};
 use core::fmt;
+use serde::Serialize;
 
 /// How the drive frequency is given: ω itself, or R (then ω = ωc √R with the effective gravity).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,11 +59,29 @@ pub struct Effects {
 }
 
 /// Which equation to integrate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Fidelity {
     Full,
     Averaged,
     Linearised,
+}
+
+impl Fidelity {
+    /// As scene files spell it: `full`, `averaged`, `linearised`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fidelity::Full => "full",
+            Fidelity::Averaged => "averaged",
+            Fidelity::Linearised => "linearised",
+        }
+    }
+}
+
+impl fmt::Display for Fidelity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// The fidelity a scene asks for; `Auto` picks the cheapest valid one and says why.
