@@ -13,8 +13,8 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 use std::time::Duration;
 
-use super::clock;
 use super::scenes::BenchScene;
+use crate::timing;
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::sim::sampling::Discard;
@@ -250,7 +250,7 @@ pub struct Point {
     pub error: f64,
     /// Median wall time of one run (s).
     pub wall_s: f64,
-    /// Median CPU time of this thread for one run (s): see [`clock`].
+    /// Median CPU time of this thread for one run (s): see [`crate::timing`].
     pub cpu_s: f64,
     pub rhs_evals: u64,
     pub steps: u64,
@@ -360,7 +360,7 @@ pub fn ours(job: &Job, batch: Duration) -> Result<Point> {
     if !err.is_finite() {
         return Err(anyhow!("the end state is not finite"));
     }
-    let cost = clock::cost(batch, || run_with(&scene, method, controller, job.format));
+    let cost = timing::cost(batch, || run_with(&scene, method, controller, job.format));
     Ok(Point {
         scene: job.scene.name.to_string(),
         family: job.family,

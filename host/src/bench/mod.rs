@@ -5,7 +5,6 @@
 //! | module | concept |
 //! |---|---|
 //! | [`scenes`] | the four scenes (settling, flutter, chaotic, long undamped) from the shipped files |
-//! | [`clock`] | wall and CPU time per run, medians of five batches |
 //! | [`measure`] | one of our runs: error against the reference, work, median time |
 //! | [`peer`] | the same for `ode_solvers`' Dopri5 and Dop853 on our right-hand side |
 //! | [`ratio`] | cost at a matched error (log-log interpolation) and ours over the peer's |
@@ -15,7 +14,6 @@
 //! | [`report`] | the results as JSON, CSV and Markdown |
 //! | [`plots`] | log-log PNGs |
 
-pub mod clock;
 pub mod ladder;
 pub mod measure;
 pub mod peer;

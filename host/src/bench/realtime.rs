@@ -15,8 +15,8 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 use std::time::Duration;
 
-use super::clock;
 use super::measure::{self, Family};
+use crate::timing;
 use kapitza_core::sim::sampling::Discard;
 use kapitza_core::sim::scene::Fidelity;
 use kapitza_core::sim::{simulate, Controller, Method, Options, Scene};
@@ -128,7 +128,7 @@ pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<
             anyhow!("{model} {family} {controller}: no tolerance down to 1e-9 reaches 1e-6")
         })?;
         let method = method(tol)?;
-        let cost = clock::cost(batch, || end(&s, method, controller));
+        let cost = timing::cost(batch, || end(&s, method, controller));
         out.push(RealTimeFactor {
             model,
             method: family,
