@@ -9,27 +9,8 @@ use super::measure::{Point, SettingName};
 use super::physical::Choice;
 use super::ratio::{curve_label, curves, AtTarget, PeerRatio};
 use super::Results;
+use crate::csv_out::{num, opt, quote};
 use kapitza_core::stability::Criterion;
-
-fn num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        String::new()
-    }
-}
-
-fn opt(x: Option<f64>) -> String {
-    x.map_or(String::new(), num)
-}
-
-fn quote(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
 
 fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
