@@ -82,6 +82,27 @@ fn header(area: &Area, title: &str, subtitle: &str) -> Result<()> {
     Ok(())
 }
 
+/// A white page: the header on top, the chart's area on the left and the legend's strip on the
+/// right, so the legend never covers data. Returns (page, chart area, legend area).
+fn page<'a>(path: &'a Path, title: &str, subtitle: &str) -> Result<(Area<'a>, Area<'a>, Area<'a>)> {
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(e)?;
+    let (top, body) = root.split_vertically(HEADER);
+    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
+    header(&top, title, subtitle)?;
+    Ok((root, left, right))
+}
+
+/// The chart in its area, with room for the axis labels.
+fn builder<'a, 'b>(area: &'a Area<'b>) -> ChartBuilder<'a, 'b, BitMapBackend<'b>> {
+    let mut b = ChartBuilder::on(area);
+    b.margin(14)
+        .margin_right(24)
+        .x_label_area_size(50)
+        .y_label_area_size(80);
+    b
+}
+
 fn legend(area: &Area, entries: &[(String, RGBColor, Mark)], notes: &[String]) -> Result<()> {
     let mut y = 24;
     for (text, c, mark) in entries {
@@ -183,26 +204,18 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
         all().map(|p| p.error.max(FLOOR)).chain([check, TARGETS[1]]),
         4.0,
     );
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
-    let (top, body) = root.split_vertically(HEADER);
-    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
     let what = match axis {
         Axis::Time => "median wall time per run",
         Axis::Evals => "right-hand-side evaluations per run",
     };
-    header(
-        &top,
+    let (root, left, right) = page(
+        path,
         &format!("Work-precision: {scene} ({:.2} s simulated, {:.0} drive periods)", info.horizon_s, info.periods),
         &format!(
             "error = max(|Δθ|, |Δθ'|/ω) at the end against DOP853 at 1e-13, against {what}; lower left is better"
         ),
     )?;
-    let mut chart = ChartBuilder::on(&left)
-        .margin(14)
-        .margin_right(24)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
+    let mut chart = builder(&left)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(e)?;
     chart
@@ -316,20 +329,12 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
         .filter(|c| c.criterion != Criterion::Floquet)
         .collect();
     let (y0, y1) = log_range(rows.iter().filter_map(|c| c.error), 3.0);
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
-    let (top, body) = root.split_vertically(HEADER);
-    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
-    header(
-        &top,
+    let (root, left, right) = page(
+        path,
         "Stability criteria against Floquet (undamped)",
         "error = larger |window end − Floquet's end| in m = A/ℓ; k < 0 inverted, k > 0 hanging",
     )?;
-    let mut chart = ChartBuilder::on(&left)
-        .margin(14)
-        .margin_right(24)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
+    let mut chart = builder(&left)
         .build_cartesian_2d(-1.0..1.0, (y0..y1).log_scale())
         .map_err(e)?;
     chart
@@ -415,20 +420,12 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
             .chain(fl.iter().filter_map(|f| f.error.map(|x| x.max(FLOOR)))),
         3.0,
     );
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
-    let (top, body) = root.split_vertically(HEADER);
-    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
-    header(
-        &top,
+    let (root, left, right) = page(
+        path,
         "Stability criteria: error against cost",
         "one point per k for each criterion; Floquet's own error against a finer Floquet as its RK4 steps per period grow",
     )?;
-    let mut chart = ChartBuilder::on(&left)
-        .margin(14)
-        .margin_right(24)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
+    let mut chart = builder(&left)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(e)?;
     chart
