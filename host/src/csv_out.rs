@@ -1,5 +1,6 @@
-//! The run's samples as CSV: a header line, then one row per sample, numbers in Rust's shortest
-//! round-trip form, an empty field for "not computed".
+//! CSV as every command writes it: a header line, then one row per record, numbers in Rust's
+//! shortest round-trip form, an empty field for "not computed" or "none", text quoted only where
+//! it holds a comma, a quote or a line break. Here too: the run's samples of `kapitza simulate`.
 
 use anyhow::{Context, Result};
 use std::fs::File;
@@ -14,11 +15,26 @@ fn create(path: &Path) -> Result<BufWriter<File>> {
     Ok(BufWriter::new(f))
 }
 
-fn num(x: f64) -> String {
+/// A number field: shortest round-trip form; empty when not finite.
+pub fn num(x: f64) -> String {
     if x.is_finite() {
         format!("{x}")
     } else {
         String::new()
+    }
+}
+
+/// An optional number field: empty for none.
+pub fn opt(x: Option<f64>) -> String {
+    x.map_or(String::new(), num)
+}
+
+/// A text field, quoted (quotes doubled) where it holds a comma, a quote or a line break.
+pub fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
     }
 }
 

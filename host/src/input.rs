@@ -5,30 +5,28 @@
 
 use anyhow::{bail, Result};
 use clap::Args;
+use kapitza_core::error::Range;
 use kapitza_core::model::{Geometry, Groups};
 
-pub fn positive(flag: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
+/// `v` if `range` admits it, else an error naming the flag.
+fn in_range(flag: &str, v: f64, range: Range) -> Result<f64> {
+    if range.admits(v) {
         Ok(v)
     } else {
-        bail!("{flag} {v} is out of range: expected a finite number > 0")
+        bail!("{flag} {v} is out of range: expected {}", range.allowed())
     }
+}
+
+pub fn positive(flag: &str, v: f64) -> Result<f64> {
+    in_range(flag, v, Range::Positive)
 }
 
 pub fn non_negative(flag: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        bail!("{flag} {v} is out of range: expected a finite number >= 0")
-    }
+    in_range(flag, v, Range::NonNegative)
 }
 
 pub fn finite(flag: &str, v: f64) -> Result<f64> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        bail!("{flag} {v} is out of range: expected a finite number")
-    }
+    in_range(flag, v, Range::Finite)
 }
 
 /// The pendulum, given as a uniform rod or a point mass on a light rod.

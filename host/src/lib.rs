@@ -17,9 +17,9 @@
 //! | [`outcome`] | the simulator's verdict in user terms, and `[expect]` judged against it |
 //! | [`record`] | what a run keeps for the output files, and its progress bar |
 //! | [`rig`] | the rig from the laptop: ports, the simulated rig, checked connections, the port's owner |
-//! | [`csv_out`] | the samples as CSV |
+//! | [`csv_out`] | CSV fields and files: the samples of a run, the fields of the bench's tables |
 //! | [`plot`] | PNG plots with a bundled font |
-//! | [`timing`] | measured cost of a function |
+//! | [`timing`] | measured cost of a call: wall and thread CPU time, medians of five batches |
 
 pub mod bench;
 pub mod calibrate;

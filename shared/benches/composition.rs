@@ -11,14 +11,13 @@
 //! Run: `cargo bench -p kapitza-core --bench composition`. Figures: docs/performance.md.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use kapitza_core::cases::TILTED_135 as TILTED;
 use kapitza_core::integrate::{rk4_step, Stats, System};
 use kapitza_core::math;
-use kapitza_core::model::{DriveAngle, Geometry};
+use kapitza_core::model::DriveAngle;
 use kapitza_core::sim::eom::{FullEom, NoExtra};
 use kapitza_core::sim::sampling::Discard;
-use kapitza_core::sim::scene::{
-    DriveFrequency, DriveSpec, Effects, Fidelity, FidelityChoice, RunLength, Sensor, Viscous,
-};
+use kapitza_core::sim::scene::{Effects, Fidelity, RunLength, Sensor, Viscous};
 use kapitza_core::sim::signal::Steady;
 use kapitza_core::sim::{simulate, Method, Options, Scene};
 
@@ -44,34 +43,32 @@ impl System<2> for HandWritten {
 const PERIODS: f64 = 512.0;
 const STEPS_PER_PERIOD: f64 = 32.0;
 
+/// The tilted example scene ([`cases::TILTED_135`]) with the given effects.
 fn scene(effects: Effects) -> Scene {
-    Scene {
-        pendulum: Geometry::rod(0.20).unwrap(),
-        drive: DriveSpec {
-            amplitude: 0.0089,
-            frequency: DriveFrequency::Omega(330.0),
-            angle: DriveAngle::from_deg(135.0).unwrap(),
-        },
-        gravity: 9.81,
-        initial_angle: math::to_rad(100.0),
-        initial_rate: 0.0,
-        length: RunLength::Periods(PERIODS),
-        fidelity: FidelityChoice::Fixed(Fidelity::Full),
-        effects,
-    }
+    let tilted = Scene::from_case(&TILTED, RunLength::Periods(PERIODS), Fidelity::Full).unwrap();
+    Scene { effects, ..tilted }
 }
 
 fn rhs(c: &mut Criterion) {
-    let (ell, a, w) = (2.0 * 0.20 / 3.0, 0.0089, 330.0);
-    let angle = DriveAngle::from_deg(135.0).unwrap();
+    let (ell, a, w) = (
+        2.0 * TILTED.rod_length / 3.0,
+        TILTED.amplitude,
+        TILTED.omega,
+    );
+    let angle = DriveAngle::from_deg(TILTED.drive_angle_deg).unwrap();
     let hand = HandWritten {
-        w0sq: 9.81 / ell,
+        w0sq: TILTED.gravity / ell,
         peak: a / ell * w * w,
         omega: w,
         sd: angle.sin(),
         cd: angle.cos(),
     };
-    let composed = FullEom::<f64, _, _>::new(9.81 / ell, angle, Steady::new(a / ell, w), NoExtra);
+    let composed = FullEom::<f64, _, _>::new(
+        TILTED.gravity / ell,
+        angle,
+        Steady::new(a / ell, w),
+        NoExtra,
+    );
     // As many steps as a scene run below, so the three rows compare directly.
     let n = (PERIODS * STEPS_PER_PERIOD) as u32;
     let h = math::TAU / w / STEPS_PER_PERIOD;

@@ -11,12 +11,10 @@
 //! Run: `cargo bench -p kapitza-core --bench realtime`. Figures: docs/performance.md.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use kapitza_core::cases::{self, SceneCase};
 use kapitza_core::math;
-use kapitza_core::model::{DriveAngle, Geometry};
 use kapitza_core::sim::sampling::Discard;
-use kapitza_core::sim::scene::{
-    DriveFrequency, DriveSpec, Effects, Fidelity, FidelityChoice, RunLength, Viscous,
-};
+use kapitza_core::sim::scene::{Fidelity, RunLength};
 use kapitza_core::sim::{simulate, Controller, Method, Options, Scene};
 use std::time::Instant;
 
@@ -25,23 +23,11 @@ const TARGET: f64 = 1e-6;
 
 /// The tilted example scene (R ≈ 3.3 at 135°) with Q = 50, for 60 s.
 fn scene(fidelity: Fidelity) -> Scene {
-    Scene {
-        pendulum: Geometry::rod(0.20).unwrap(),
-        drive: DriveSpec {
-            amplitude: 0.0089,
-            frequency: DriveFrequency::Omega(330.0),
-            angle: DriveAngle::from_deg(135.0).unwrap(),
-        },
-        gravity: 9.81,
-        initial_angle: math::to_rad(100.0),
-        initial_rate: 0.0,
-        length: RunLength::Duration(SIMULATED),
-        fidelity: FidelityChoice::Fixed(fidelity),
-        effects: Effects {
-            viscous: Some(Viscous::Q(50.0)),
-            ..Effects::default()
-        },
-    }
+    let case = SceneCase {
+        q: 50.0,
+        ..cases::TILTED_135
+    };
+    Scene::from_case(&case, RunLength::Duration(SIMULATED), fidelity).unwrap()
 }
 
 /// A method and its step controller.
@@ -58,7 +44,7 @@ fn options((method, controller): Setting) -> Options {
 
 fn end(s: &Scene, m: impl Into<Setting>) -> (f64, f64) {
     let r = simulate(s, &options(m.into()), &mut Discard).unwrap();
-    (r.end.1, r.end.2)
+    r.end.angle_rate()
 }
 
 fn error(a: (f64, f64), b: (f64, f64), omega: f64) -> f64 {

@@ -126,6 +126,37 @@ pub const LANDAU: LandauCase = LandauCase {
     lower_amplitude: printed(0.492, 3),
 };
 
+/// A shipped scene's pendulum (a uniform rod), drive, start and damping as numbers, for code
+/// that builds the scene rather than reading its file ([`crate::sim::Scene::from_case`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneCase {
+    /// Length of the rod (m).
+    pub rod_length: f64,
+    /// Drive amplitude A (m).
+    pub amplitude: f64,
+    /// Drive frequency ω (rad/s).
+    pub omega: f64,
+    pub drive_angle_deg: f64,
+    pub gravity: f64,
+    pub initial_angle_deg: f64,
+    pub initial_rate: f64,
+    /// Viscous damping as a quality factor.
+    pub q: f64,
+}
+
+/// `scenes/tilted-135.toml`: rod 0.20 m, A = 8.9 mm, ω = 330 rad/s, θd = 135°, Q = 20, from
+/// 100° at rest; R ≈ 3.3, and averaged theory puts the reachable stable rest at 118.98°.
+pub const TILTED_135: SceneCase = SceneCase {
+    rod_length: 0.20,
+    amplitude: 0.0089,
+    omega: 330.0,
+    drive_angle_deg: 135.0,
+    gravity: 9.81,
+    initial_angle_deg: 100.0,
+    initial_rate: 0.0,
+    q: 20.0,
+};
+
 #[cfg(test)]
 mod tests {
     use super::*;

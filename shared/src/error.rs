@@ -44,43 +44,64 @@ impl fmt::Display for Compact {
 #[cfg(feature = "std")]
 impl std::error::Error for ParamError {}
 
+/// The ranges numbers are checked against, each with the words its error messages use: the one
+/// definition behind the core's checks and the command line's and scene files' messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Range {
+    /// A finite number > 0.
+    Positive,
+    /// A finite number ≥ 0.
+    NonNegative,
+    /// Any finite number.
+    Finite,
+}
+
+impl Range {
+    pub fn admits(self, value: f64) -> bool {
+        value.is_finite()
+            && match self {
+                Range::Positive => value > 0.0,
+                Range::NonNegative => value >= 0.0,
+                Range::Finite => true,
+            }
+    }
+
+    /// What is allowed, as messages say it.
+    pub fn allowed(self) -> &'static str {
+        match self {
+            Range::Positive => "a finite number > 0",
+            Range::NonNegative => "a finite number >= 0",
+            Range::Finite => "a finite number",
+        }
+    }
+
+    /// `value` if the range admits it, else the error naming the parameter.
+    pub fn check(self, name: &'static str, value: f64) -> Result<f64, ParamError> {
+        if self.admits(value) {
+            Ok(value)
+        } else {
+            Err(ParamError {
+                name,
+                value,
+                allowed: self.allowed(),
+            })
+        }
+    }
+}
+
 /// Accepts a finite number > 0.
 pub fn positive(name: &'static str, value: f64) -> Result<f64, ParamError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(ParamError {
-            name,
-            value,
-            allowed: "a finite number > 0",
-        })
-    }
+    Range::Positive.check(name, value)
 }
 
 /// Accepts a finite number ≥ 0.
 pub fn non_negative(name: &'static str, value: f64) -> Result<f64, ParamError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(ParamError {
-            name,
-            value,
-            allowed: "a finite number >= 0",
-        })
-    }
+    Range::NonNegative.check(name, value)
 }
 
 /// Accepts any finite number.
 pub fn finite(name: &'static str, value: f64) -> Result<f64, ParamError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(ParamError {
-            name,
-            value,
-            allowed: "a finite number",
-        })
-    }
+    Range::Finite.check(name, value)
 }
 
 #[cfg(test)]

@@ -5,8 +5,6 @@
 //! parameters against its plant alone, and the slider-crank's second harmonic against physics
 //! §3's sinusoidal drive. docs/calibration.md has the figures.
 
-mod sim_bench;
-
 use kapitza_core::calib::plumb;
 use kapitza_core::integrate::{rk4_step, Stats};
 use kapitza_core::link::convert::from_q16;
@@ -15,7 +13,7 @@ use kapitza_core::math;
 use kapitza_core::rig::fixed::Angle;
 use kapitza_core::simrig::plant::Plant;
 use kapitza_core::simrig::Params;
-use sim_bench::Bench;
+use kapitza_test_support::sim_bench::Bench;
 
 const ROD: f64 = 0.06;
 

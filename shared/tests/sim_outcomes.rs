@@ -1,5 +1,6 @@
 //! The simulator against closed forms and the averaged theory (physics §3–5).
 
+use kapitza_core::cases;
 use kapitza_core::math;
 use kapitza_core::model::{equilibria, DriveAngle, Geometry};
 use kapitza_core::sim::sampling::Discard;
@@ -8,25 +9,14 @@ use kapitza_core::sim::scene::{
 };
 use kapitza_core::sim::{simulate, Format, Method, Options, Outcome, Scene};
 
-/// The tilted example scene: rod 0.20 m, A = 8.9 mm, ω = 330 rad/s, θd = 135°, Q = 50, from 100°.
+/// The tilted example scene ([`cases::TILTED_135`]) for 3000 drive periods.
 fn tilted() -> Scene {
-    Scene {
-        pendulum: Geometry::rod(0.20).unwrap(),
-        drive: DriveSpec {
-            amplitude: 0.0089,
-            frequency: DriveFrequency::Omega(330.0),
-            angle: DriveAngle::from_deg(135.0).unwrap(),
-        },
-        gravity: 9.81,
-        initial_angle: math::to_rad(100.0),
-        initial_rate: 0.0,
-        length: RunLength::Periods(3000.0),
-        fidelity: FidelityChoice::Fixed(Fidelity::Full),
-        effects: Effects {
-            viscous: Some(Viscous::Q(20.0)),
-            ..Effects::default()
-        },
-    }
+    Scene::from_case(
+        &cases::TILTED_135,
+        RunLength::Periods(3000.0),
+        Fidelity::Full,
+    )
+    .unwrap()
 }
 
 fn rest_deg(o: Outcome) -> f64 {
@@ -136,7 +126,8 @@ fn symplectic_methods_agree_with_dop853() {
                 scheme,
                 steps_per_period: spp,
             };
-            (simulate(&scene, &quiet(m), &mut Discard).unwrap().end.1 - reference.end.1).abs()
+            (simulate(&scene, &quiet(m), &mut Discard).unwrap().end.theta - reference.end.theta)
+                .abs()
         };
         let (coarse, fine) = (err(spp), err(2.0 * spp));
         let measured = (coarse / fine).log2();

@@ -70,3 +70,16 @@ fn the_documented_example_meets_its_expectation() {
     let _ = std::fs::remove_dir_all(&dir);
     assert!(result.is_ok(), "{}", String::from_utf8_lossy(&out));
 }
+
+/// The canonical tilted scene that tests and benchmarks build in code is the shipped file.
+#[test]
+fn tilted_case_is_the_shipped_file() {
+    use kapitza_core::cases::TILTED_135;
+    use kapitza_core::sim::scene::{Fidelity, RunLength};
+    use kapitza_core::sim::Scene;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let file = kapitza::scene_file::load(&dir.join("tilted-135.toml"), &[]).unwrap();
+    let built = Scene::from_case(&TILTED_135, file.scene.length, Fidelity::Full).unwrap();
+    assert_eq!(built, file.scene);
+    assert_eq!(file.scene.length, RunLength::Periods(4000.0));
+}

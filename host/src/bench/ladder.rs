@@ -15,7 +15,9 @@ use serde::Serialize;
 use std::time::Duration;
 
 use crate::timing::seconds_per_eval;
-use kapitza_core::stability::{averaging, floquet::Floquet, harmonic_balance, mathieu, Window};
+use kapitza_core::stability::{
+    averaging, floquet::Floquet, harmonic_balance, mathieu, Criterion, Position, Window,
+};
 
 /// Bisection tolerance in m of the Floquet reference for the criteria (their errors are ≥ 1e-8).
 pub const CRITERIA_TOL: f64 = 1e-11;
@@ -26,10 +28,8 @@ pub const CONVERGENCE_TOL: f64 = 1e-14;
 #[derive(Debug, Clone, Serialize)]
 pub struct CriterionRow {
     pub k: f64,
-    /// `"inverted"` or `"hanging"`.
-    pub position: &'static str,
-    /// `"averaging"`, `"mathieu"`, `"harmonic_balance"` or `"floquet"`.
-    pub criterion: &'static str,
+    pub position: Position,
+    pub criterion: Criterion,
     pub lower: Option<f64>,
     pub upper: Option<f64>,
     pub floquet_lower: Option<f64>,
@@ -75,7 +75,7 @@ fn abs_diff(a: Option<f64>, b: Option<f64>) -> Option<f64> {
 
 fn row(
     k: f64,
-    criterion: &'static str,
+    criterion: Criterion,
     w: &Window,
     reference: &Window,
     seconds_per_eval: f64,
@@ -90,7 +90,7 @@ fn row(
     };
     CriterionRow {
         k,
-        position: if k < 0.0 { "inverted" } else { "hanging" },
+        position: Position::of_k(k),
         criterion,
         lower,
         upper,
@@ -115,26 +115,26 @@ pub fn criteria(plan: &LadderPlan, mut tick: impl FnMut()) -> Result<Vec<Criteri
         let cost_f = seconds_per_eval(b, || fl.window(k, 0.0, CRITERIA_TOL));
         rows.push(row(
             k,
-            "averaging",
+            Criterion::Averaging,
             &averaging::window(k)?,
             &reference,
             seconds_per_eval(b, || averaging::window(k)),
         ));
         rows.push(row(
             k,
-            "mathieu",
+            Criterion::Mathieu,
             &mathieu::window(k)?,
             &reference,
             seconds_per_eval(b, || mathieu::window(k)),
         ));
         rows.push(row(
             k,
-            "harmonic_balance",
+            Criterion::HarmonicBalance,
             &harmonic_balance::window(k)?,
             &reference,
             seconds_per_eval(b, || harmonic_balance::window(k)),
         ));
-        rows.push(row(k, "floquet", &reference, &reference, cost_f));
+        rows.push(row(k, Criterion::Floquet, &reference, &reference, cost_f));
         tick();
     }
     Ok(rows)
@@ -150,7 +150,7 @@ pub fn floquet_convergence(plan: &LadderPlan, mut tick: impl FnMut()) -> Result<
         for &n in &plan.floquet_steps {
             let fl = Floquet::new(n)?;
             let w = fl.window(k, 0.0, CONVERGENCE_TOL)?;
-            let r = row(k, "floquet", &w.value, &reference, 0.0);
+            let r = row(k, Criterion::Floquet, &w.value, &reference, 0.0);
             rows.push(FloquetRow {
                 k,
                 steps_per_period: n,

@@ -13,8 +13,8 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 use std::time::Duration;
 
-use super::clock;
 use super::scenes::BenchScene;
+use crate::timing;
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::sim::sampling::Discard;
@@ -136,12 +136,21 @@ impl Family {
         )
     }
 
-    /// What the setting is: `"rtol"` (= atol) or `"steps_per_period"`.
-    pub fn setting_name(self) -> &'static str {
+    /// What the setting is: a tolerance or a step count.
+    pub fn setting_name(self) -> SettingName {
         if self.adaptive() {
-            "rtol"
+            SettingName::Rtol
         } else {
-            "steps_per_period"
+            SettingName::StepsPerPeriod
+        }
+    }
+
+    /// Who made the measurement.
+    pub fn who(self) -> Who {
+        if self.is_peer() {
+            Who::Peer
+        } else {
+            Who::Ours
         }
     }
 
@@ -184,10 +193,45 @@ impl Family {
     }
 }
 
-pub fn format_name(f: Format) -> &'static str {
-    match f {
-        Format::F64 => "f64",
-        Format::F32 => "f32",
+impl std::fmt::Display for Family {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Whose integrator a measurement ran: ours or the peer's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Who {
+    Ours,
+    Peer,
+}
+
+impl std::fmt::Display for Who {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Who::Ours => "ours",
+            Who::Peer => "peer",
+        })
+    }
+}
+
+/// What a ladder's setting is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SettingName {
+    /// A tolerance, rtol = atol.
+    Rtol,
+    /// Fixed steps per drive period.
+    StepsPerPeriod,
+}
+
+impl std::fmt::Display for SettingName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SettingName::Rtol => "rtol",
+            SettingName::StepsPerPeriod => "steps_per_period",
+        })
     }
 }
 
@@ -196,20 +240,17 @@ pub fn format_name(f: Format) -> &'static str {
 pub struct Point {
     pub scene: String,
     pub family: Family,
-    /// `"ours"` or `"peer"`.
-    pub who: &'static str,
-    /// `"full"` or `"averaged"`.
-    pub fidelity: &'static str,
-    /// `"f64"` or `"f32"`.
-    pub format: &'static str,
-    /// `"rtol"` (= atol) or `"steps_per_period"`.
-    pub setting_name: &'static str,
+    pub who: Who,
+    /// Full or averaged.
+    pub fidelity: Fidelity,
+    pub format: Format,
+    pub setting_name: SettingName,
     pub setting: f64,
     /// max(|Δθ|, |Δθ'|/ω) at the end against the reference.
     pub error: f64,
     /// Median wall time of one run (s).
     pub wall_s: f64,
-    /// Median CPU time of this thread for one run (s): see [`clock`].
+    /// Median CPU time of this thread for one run (s): see [`crate::timing`].
     pub cpu_s: f64,
     pub rhs_evals: u64,
     pub steps: u64,
@@ -266,10 +307,6 @@ pub fn run_with(
     simulate(scene, &options, &mut Discard).map_err(|e| anyhow!("{e}"))
 }
 
-fn end_of(r: &Report) -> (f64, f64) {
-    (r.end.1, r.end.2)
-}
-
 /// The converged reference of a scene's full model, with its check.
 pub fn reference(s: &BenchScene) -> Result<Reference> {
     let at = |tol: f64| {
@@ -286,11 +323,11 @@ pub fn reference(s: &BenchScene) -> Result<Reference> {
     let c = at(CHECK_TOL)?;
     let omega = s.scene.physical()?.omega;
     Ok(Reference {
-        theta: r.end.1,
-        rate: r.end.2,
+        theta: r.end.theta,
+        rate: r.end.rate,
         rtol: REFERENCE_TOL,
         check_rtol: CHECK_TOL,
-        check_difference: error(end_of(&r), end_of(&c), omega),
+        check_difference: error(r.end.angle_rate(), c.end.angle_rate(), omega),
         rhs_evals: r.work.rhs_evals,
     })
 }
@@ -315,21 +352,21 @@ pub fn ours(job: &Job, batch: Duration) -> Result<Point> {
     let omega = scene.physical()?.omega;
     let controller = job.family.controller();
     let r = run_with(&scene, method, controller, job.format)?;
-    let err = error(end_of(&r), (job.reference.theta, job.reference.rate), omega);
+    let err = error(
+        r.end.angle_rate(),
+        (job.reference.theta, job.reference.rate),
+        omega,
+    );
     if !err.is_finite() {
         return Err(anyhow!("the end state is not finite"));
     }
-    let cost = clock::cost(batch, || run_with(&scene, method, controller, job.format));
+    let cost = timing::cost(batch, || run_with(&scene, method, controller, job.format));
     Ok(Point {
         scene: job.scene.name.to_string(),
         family: job.family,
-        who: "ours",
-        fidelity: if job.family.fidelity() == Fidelity::Averaged {
-            "averaged"
-        } else {
-            "full"
-        },
-        format: format_name(job.format),
+        who: job.family.who(),
+        fidelity: job.family.fidelity(),
+        format: job.format,
         setting_name: job.family.setting_name(),
         setting: job.setting,
         error: err,

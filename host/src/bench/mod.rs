@@ -5,7 +5,6 @@
 //! | module | concept |
 //! |---|---|
 //! | [`scenes`] | the four scenes (settling, flutter, chaotic, long undamped) from the shipped files |
-//! | [`clock`] | wall and CPU time per run, medians of five batches |
 //! | [`measure`] | one of our runs: error against the reference, work, median time |
 //! | [`peer`] | the same for `ode_solvers`' Dopri5 and Dop853 on our right-hand side |
 //! | [`ratio`] | cost at a matched error (log-log interpolation) and ours over the peer's |
@@ -15,7 +14,6 @@
 //! | [`report`] | the results as JSON, CSV and Markdown |
 //! | [`plots`] | log-log PNGs |
 
-pub mod clock;
 pub mod ladder;
 pub mod measure;
 pub mod peer;
@@ -337,6 +335,14 @@ fn averaged_valid(s: &BenchScene) -> bool {
         .is_some_and(|d| d.fidelity == kapitza_core::sim::scene::Fidelity::Averaged)
 }
 
+/// One measurement to make: a family at one setting on one scene.
+struct Measurement {
+    scene: usize,
+    family: Family,
+    format: Format,
+    setting: f64,
+}
+
 /// Runs everything in `plan`.
 pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
     let started = std::time::Instant::now();
@@ -345,114 +351,20 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
     let mut skipped = Vec::new();
     let mut notes = Vec::new();
 
-    // Plan the measurement jobs first, so the progress bar knows its length.
-    let mut jobs: Vec<(usize, Family, Format, f64)> = Vec::new();
-    for (i, s) in scenes.iter().enumerate() {
-        let valid = averaged_valid(s);
-        for (family, format, settings) in &plan.ladders {
-            if !applies(*family, s, valid) {
-                continue;
-            }
-            for &setting in settings {
-                let predicted = s.periods() * setting * evals_per_step(*family);
-                if predicted > plan.max_evals {
-                    skipped.push(format!(
-                        "{}: {} {} at {} steps per period (≈ {predicted:.1e} evaluations, over the budget of {:.0e})",
-                        s.name,
-                        family.label(),
-                        measure::format_name(*format),
-                        setting,
-                        plan.max_evals
-                    ));
-                    continue;
-                }
-                jobs.push((i, *family, *format, setting));
-            }
-        }
-        for family in [
-            Family::PeerDopri5,
-            Family::PeerDop853,
-            Family::PeerDop853Autonomous,
-        ] {
-            for &tol in &plan.peer {
-                jobs.push((i, family, Format::F64, tol));
-            }
-        }
-    }
-    let physical_ticks: usize = scenes
-        .iter()
-        .map(|s| {
-            plan.physical
-                .iter()
-                .filter(|(f, _, _)| {
-                    s.undamped || !matches!(f, Family::Verlet | Family::Yoshida4 | Family::Yoshida6)
-                })
-                .count()
-                + 1
-        })
-        .sum();
-    let total = scenes.len()
-        + jobs.len()
-        + plan.ladder.ks.len()
-        + plan.ladder.floquet_ks.len() * plan.ladder.floquet_steps.len()
-        + physical_ticks
-        + 2 * plan.calibration_ratios.len()
-        + plan.fate_tolerances.len()
-        + realtime::RECORDS.len();
-    progress.set_total(total as u64);
+    // Plan the measurements first, so the progress bar knows its length.
+    let jobs = measurements(plan, &scenes, &mut skipped);
+    progress.set_total(ticks(plan, &scenes, jobs.len()));
 
-    let mut references = Vec::new();
-    for s in &scenes {
-        references.push(measure::reference(s)?);
-        progress.tick(&format!("reference: {}", s.name));
-    }
-
-    let mut points = Vec::new();
-    let mut failed: Vec<(String, String, Vec<f64>, String)> = Vec::new();
-    for (i, family, format, setting) in jobs {
-        let s = &scenes[i];
-        let what = format!(
-            "{}: {} {} at {setting}",
-            s.name,
-            family.label(),
-            measure::format_name(format)
-        );
-        let got = if family.is_peer() {
-            peer::peer(s, &references[i], family, setting, plan.batch, &mut notes)
-        } else {
-            measure::ours(
-                &measure::Job {
-                    scene: s,
-                    reference: &references[i],
-                    family,
-                    format,
-                    setting,
-                },
-                plan.batch,
-            )
-        };
-        match got {
-            Ok(p) => points.push(p),
-            Err(e) => {
-                let method = ratio::curve_label(family, measure::format_name(format));
-                match failed.iter_mut().find(|f| f.0 == s.name && f.1 == method) {
-                    Some(f) => f.2.push(setting),
-                    None => {
-                        failed.push((s.name.to_string(), method, vec![setting], format!("{e:#}")))
-                    }
-                }
-            }
-        }
-        progress.tick(&what);
-    }
-    for (scene, method, settings, first) in failed {
-        let list: Vec<String> = settings.iter().map(|x| format!("{x:e}")).collect();
-        skipped.push(format!(
-            "{scene}: {method} failed at {} (first: {first})",
-            list.join(", ")
-        ));
-    }
-
+    let references = references(&scenes, progress)?;
+    let points = measure(
+        plan,
+        &scenes,
+        &references,
+        jobs,
+        progress,
+        &mut skipped,
+        &mut notes,
+    );
     let ratios = |workaround: bool| {
         scenes
             .iter()
@@ -489,6 +401,182 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
         None => Vec::new(),
     };
 
+    let scene_out = scene_facts(&scenes, references, &physical_rows, plan.batch)?;
+    let real_time_factors =
+        realtime::real_time_factors(plan.batch, || progress.tick("real-time factors"))?;
+    machine.load_end = load_average();
+    Ok(Results {
+        quick: plan.quick,
+        machine,
+        scenes: scene_out,
+        peer_ratios,
+        peer_as_published_ratios,
+        measurements: points,
+        stability_criteria,
+        floquet_convergence,
+        physical: physical_rows,
+        averaged_thresholds: physical::thresholds(&averaged_validity),
+        averaged_validity,
+        chaotic_fate,
+        real_time_factors,
+        skipped,
+        notes,
+        wall_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// Every (scene, family, setting) of the ladders that applies and fits the evaluation budget,
+/// then the peer's; what is over the budget goes to `skipped`.
+fn measurements(plan: &Plan, scenes: &[BenchScene], skipped: &mut Vec<String>) -> Vec<Measurement> {
+    let mut jobs = Vec::new();
+    for (i, s) in scenes.iter().enumerate() {
+        let valid = averaged_valid(s);
+        for (family, format, settings) in &plan.ladders {
+            if !applies(*family, s, valid) {
+                continue;
+            }
+            for &setting in settings {
+                let predicted = s.periods() * setting * evals_per_step(*family);
+                if predicted > plan.max_evals {
+                    skipped.push(format!(
+                        "{}: {} {} at {} steps per period (≈ {predicted:.1e} evaluations, over the budget of {:.0e})",
+                        s.name,
+                        family.label(),
+                        format,
+                        setting,
+                        plan.max_evals
+                    ));
+                    continue;
+                }
+                jobs.push(Measurement {
+                    scene: i,
+                    family: *family,
+                    format: *format,
+                    setting,
+                });
+            }
+        }
+        for family in [
+            Family::PeerDopri5,
+            Family::PeerDop853,
+            Family::PeerDop853Autonomous,
+        ] {
+            for &tol in &plan.peer {
+                jobs.push(Measurement {
+                    scene: i,
+                    family,
+                    format: Format::F64,
+                    setting: tol,
+                });
+            }
+        }
+    }
+    jobs
+}
+
+/// How many progress ticks the whole run makes.
+fn ticks(plan: &Plan, scenes: &[BenchScene], measurements: usize) -> u64 {
+    let physical_ticks: usize = scenes
+        .iter()
+        .map(|s| {
+            plan.physical
+                .iter()
+                .filter(|(f, _, _)| {
+                    s.undamped || !matches!(f, Family::Verlet | Family::Yoshida4 | Family::Yoshida6)
+                })
+                .count()
+                + 1
+        })
+        .sum();
+    let total = scenes.len()
+        + measurements
+        + plan.ladder.ks.len()
+        + plan.ladder.floquet_ks.len() * plan.ladder.floquet_steps.len()
+        + physical_ticks
+        + 2 * plan.calibration_ratios.len()
+        + plan.fate_tolerances.len()
+        + realtime::RECORDS.len();
+    total as u64
+}
+
+/// The converged reference of each scene.
+fn references(scenes: &[BenchScene], progress: &mut dyn Progress) -> Result<Vec<Reference>> {
+    let mut references = Vec::new();
+    for s in scenes {
+        references.push(measure::reference(s)?);
+        progress.tick(&format!("reference: {}", s.name));
+    }
+    Ok(references)
+}
+
+/// Makes every measurement; a method that fails is listed once per scene in `skipped`, with
+/// the settings it failed at and the first error.
+fn measure(
+    plan: &Plan,
+    scenes: &[BenchScene],
+    references: &[Reference],
+    jobs: Vec<Measurement>,
+    progress: &mut dyn Progress,
+    skipped: &mut Vec<String>,
+    notes: &mut Vec<String>,
+) -> Vec<Point> {
+    let mut points = Vec::new();
+    let mut failed: Vec<(String, String, Vec<f64>, String)> = Vec::new();
+    for Measurement {
+        scene: i,
+        family,
+        format,
+        setting,
+    } in jobs
+    {
+        let s = &scenes[i];
+        let what = format!("{}: {} {format} at {setting}", s.name, family.label());
+        let got = if family.is_peer() {
+            peer::peer(s, &references[i], family, setting, plan.batch, notes)
+        } else {
+            measure::ours(
+                &measure::Job {
+                    scene: s,
+                    reference: &references[i],
+                    family,
+                    format,
+                    setting,
+                },
+                plan.batch,
+            )
+        };
+        match got {
+            Ok(p) => points.push(p),
+            Err(e) => {
+                let method = ratio::curve_label(family, format);
+                match failed.iter_mut().find(|f| f.0 == s.name && f.1 == method) {
+                    Some(f) => f.2.push(setting),
+                    None => {
+                        failed.push((s.name.to_string(), method, vec![setting], format!("{e:#}")))
+                    }
+                }
+            }
+        }
+        progress.tick(&what);
+    }
+    for (scene, method, settings, first) in failed {
+        let list: Vec<String> = settings.iter().map(|x| format!("{x:e}")).collect();
+        skipped.push(format!(
+            "{scene}: {method} failed at {} (first: {first})",
+            list.join(", ")
+        ));
+    }
+    points
+}
+
+/// Each scene's facts for the report, with the chaotic scene's Lyapunov exponent from the
+/// physical question's reference run.
+fn scene_facts(
+    scenes: &[BenchScene],
+    references: Vec<Reference>,
+    physical_rows: &[physical::PhysicalRow],
+    batch: Duration,
+) -> Result<Vec<SceneOut>> {
     let mut scene_out = Vec::new();
     for (s, reference) in scenes.iter().zip(references) {
         let p = s.scene.physical()?;
@@ -513,31 +601,11 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<Results> {
             averaged_valid: averaged_valid(s),
             reference,
             predictability_s: lyapunov.map(|l| (1.0 / f64::EPSILON).ln() / l),
-            rhs_seconds: peer::rhs_cost(&s.scene, plan.batch)?,
+            rhs_seconds: peer::rhs_cost(&s.scene, batch)?,
             lyapunov,
         });
     }
-    let real_time_factors =
-        realtime::real_time_factors(plan.batch, || progress.tick("real-time factors"))?;
-    machine.load_end = load_average();
-    Ok(Results {
-        quick: plan.quick,
-        machine,
-        scenes: scene_out,
-        peer_ratios,
-        peer_as_published_ratios,
-        measurements: points,
-        stability_criteria,
-        floquet_convergence,
-        physical: physical_rows,
-        averaged_thresholds: physical::thresholds(&averaged_validity),
-        averaged_validity,
-        chaotic_fate,
-        real_time_factors,
-        skipped,
-        notes,
-        wall_s: started.elapsed().as_secs_f64(),
-    })
+    Ok(scene_out)
 }
 
 const HORIZONTAL: &str = include_str!("../../../scenes/horizontal-r1.75.toml");

@@ -31,13 +31,13 @@ use ode_solvers::{Dop853, Dopri5, OutputType, Vector2, Vector3};
 use std::cell::Cell;
 use std::time::Duration;
 
-use super::clock;
 use super::measure::{error, Family, Point, Reference};
 use super::scenes::BenchScene;
+use crate::timing;
 use kapitza_core::integrate::System;
 use kapitza_core::sim::eom::{FullEom, NoExtra, Viscous};
 use kapitza_core::sim::signal::Steady;
-use kapitza_core::sim::Scene;
+use kapitza_core::sim::{Format, Scene};
 
 /// Counts evaluations, or not.
 trait Tally {
@@ -268,14 +268,14 @@ pub fn peer(
             r.evals_reported
         ));
     }
-    let cost = clock::cost(batch, || run_with(family, &s.scene, &NoTally, tol));
+    let cost = timing::cost(batch, || run_with(family, &s.scene, &NoTally, tol));
     Ok(Point {
         scene: s.name.to_string(),
         family,
-        who: "peer",
-        fidelity: "full",
-        format: "f64",
-        setting_name: "rtol",
+        who: family.who(),
+        fidelity: family.fidelity(),
+        format: Format::F64,
+        setting_name: family.setting_name(),
         setting: tol,
         error: err,
         wall_s: cost.wall_s,
@@ -291,7 +291,7 @@ pub fn peer(
 pub fn rhs_cost(scene: &Scene, batch: Duration) -> Result<f64> {
     fn time<S: System<2, f64>>(eom: S, batch: Duration) -> f64 {
         let mut k = 0u32;
-        clock::cost(batch, || {
+        timing::cost(batch, || {
             k = k.wrapping_add(1);
             let t = std::hint::black_box(1e-3 * f64::from(k % 1000));
             let y = std::hint::black_box([2.0, 0.5]);

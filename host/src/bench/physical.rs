@@ -17,7 +17,7 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 use std::time::Duration;
 
-use super::measure::{options, Family};
+use super::measure::{options, Family, SettingName};
 use super::scenes::BenchScene;
 use crate::outcome::OutcomeOut;
 use crate::timing::seconds_per_eval;
@@ -80,10 +80,10 @@ pub struct Choice {
     /// e.g. "RK4 f32".
     pub method: String,
     pub family: Family,
-    pub format: &'static str,
-    /// `"full"` or `"averaged"`.
-    pub fidelity: &'static str,
-    pub setting_name: &'static str,
+    pub format: Format,
+    /// Full or averaged.
+    pub fidelity: Fidelity,
+    pub setting_name: SettingName,
     pub setting: f64,
     pub answer: OutcomeOut,
     pub wall_s: f64,
@@ -94,7 +94,7 @@ pub struct Choice {
 /// What `fidelity = "auto"` with the default method (DOP853 at 1e-9, f64) does.
 #[derive(Debug, Clone, Serialize)]
 pub struct AutoChoice {
-    pub fidelity: &'static str,
+    pub fidelity: Fidelity,
     pub reason: String,
     pub answer: OutcomeOut,
     pub right: bool,
@@ -114,14 +114,6 @@ pub struct PhysicalRow {
     /// The cheapest right one by time.
     pub cheapest: Option<Choice>,
     pub auto: AutoChoice,
-}
-
-fn fidelity_name(f: Fidelity) -> &'static str {
-    match f {
-        Fidelity::Full => "full",
-        Fidelity::Averaged => "averaged",
-        Fidelity::Linearised => "linearised",
-    }
 }
 
 fn with_fidelity(scene: &Scene, f: Fidelity) -> Scene {
@@ -176,10 +168,10 @@ pub fn question(
         let choice = |i: usize, wall_s: f64| {
             let (setting, r) = &answers[i];
             Choice {
-                method: super::ratio::curve_label(*family, super::measure::format_name(*format)),
+                method: super::ratio::curve_label(*family, *format),
                 family: *family,
-                format: super::measure::format_name(*format),
-                fidelity: fidelity_name(family.fidelity()),
+                format: *format,
+                fidelity: family.fidelity(),
                 setting_name: family.setting_name(),
                 setting: *setting,
                 answer: OutcomeOut::from(r.outcome),
@@ -209,7 +201,7 @@ pub fn question(
     let a = classified(&auto_scene, Method::DEFAULT, Format::F64)?;
     let answer = OutcomeOut::from(a.outcome);
     let auto = AutoChoice {
-        fidelity: fidelity_name(a.decision.fidelity),
+        fidelity: a.decision.fidelity,
         reason: a.decision.to_string(),
         right: right(&answer, &reference),
         answer,

@@ -13,6 +13,8 @@ use std::path::Path;
 use super::measure::{Family, Point};
 use super::ratio::{curve_label, curves};
 use super::{Results, TARGETS};
+use kapitza_core::sim::Format;
+use kapitza_core::stability::Criterion;
 
 const FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 const SIZE: (u32, u32) = (1280, 760);
@@ -78,6 +80,27 @@ fn header(area: &Area, title: &str, subtitle: &str) -> Result<()> {
     ))
     .map_err(e)?;
     Ok(())
+}
+
+/// A white page: the header on top, the chart's area on the left and the legend's strip on the
+/// right, so the legend never covers data. Returns (page, chart area, legend area).
+fn page<'a>(path: &'a Path, title: &str, subtitle: &str) -> Result<(Area<'a>, Area<'a>, Area<'a>)> {
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(e)?;
+    let (top, body) = root.split_vertically(HEADER);
+    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
+    header(&top, title, subtitle)?;
+    Ok((root, left, right))
+}
+
+/// The chart in its area, with room for the axis labels.
+fn builder<'a, 'b>(area: &'a Area<'b>) -> ChartBuilder<'a, 'b, BitMapBackend<'b>> {
+    let mut b = ChartBuilder::on(area);
+    b.margin(14)
+        .margin_right(24)
+        .x_label_area_size(50)
+        .y_label_area_size(80);
+    b
 }
 
 fn legend(area: &Area, entries: &[(String, RGBColor, Mark)], notes: &[String]) -> Result<()> {
@@ -181,26 +204,18 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
         all().map(|p| p.error.max(FLOOR)).chain([check, TARGETS[1]]),
         4.0,
     );
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
-    let (top, body) = root.split_vertically(HEADER);
-    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
     let what = match axis {
         Axis::Time => "median wall time per run",
         Axis::Evals => "right-hand-side evaluations per run",
     };
-    header(
-        &top,
+    let (root, left, right) = page(
+        path,
         &format!("Work-precision: {scene} ({:.2} s simulated, {:.0} drive periods)", info.horizon_s, info.periods),
         &format!(
             "error = max(|Δθ|, |Δθ'|/ω) at the end against DOP853 at 1e-13, against {what}; lower left is better"
         ),
     )?;
-    let mut chart = ChartBuilder::on(&left)
-        .margin(14)
-        .margin_right(24)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
+    let mut chart = builder(&left)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(e)?;
     chart
@@ -248,7 +263,7 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
             .collect();
         let mark = if family.is_peer() {
             Mark::Triangle
-        } else if *format == "f32" {
+        } else if *format == Format::F32 {
             Mark::Dashed
         } else {
             Mark::Solid
@@ -279,7 +294,7 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
                     .map_err(e)?;
             }
         }
-        entries.push((curve_label(*family, format), c, mark));
+        entries.push((curve_label(*family, *format), c, mark));
     }
     let notes = vec![
         "grey dashes: target errors 1e-6, 1e-9".to_string(),
@@ -296,25 +311,14 @@ pub fn work_precision(path: &Path, r: &Results, scene: &str, axis: Axis) -> Resu
     Ok(())
 }
 
-fn criterion_colour(name: &str) -> RGBColor {
-    match name {
-        "averaging" => RGBColor(255, 127, 14),
-        "mathieu" => RGBColor(31, 119, 180),
-        "harmonic_balance" => RGBColor(44, 160, 44),
-        _ => RGBColor(0, 0, 0),
+fn criterion_colour(c: Criterion) -> RGBColor {
+    match c {
+        Criterion::Averaging => RGBColor(255, 127, 14),
+        Criterion::Mathieu => RGBColor(31, 119, 180),
+        Criterion::HarmonicBalance => RGBColor(44, 160, 44),
+        Criterion::Floquet => RGBColor(0, 0, 0),
     }
 }
-
-fn criterion_label(name: &str) -> &'static str {
-    match name {
-        "averaging" => "averaging",
-        "mathieu" => "Mathieu series",
-        "harmonic_balance" => "harmonic balance",
-        _ => "Floquet",
-    }
-}
-
-const CRITERIA: [&str; 3] = ["averaging", "mathieu", "harmonic_balance"];
 
 /// Each cheaper criterion's error against Floquet as k varies.
 pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
@@ -322,23 +326,15 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
     let rows: Vec<_> = r
         .stability_criteria
         .iter()
-        .filter(|c| c.criterion != "floquet")
+        .filter(|c| c.criterion != Criterion::Floquet)
         .collect();
     let (y0, y1) = log_range(rows.iter().filter_map(|c| c.error), 3.0);
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
-    let (top, body) = root.split_vertically(HEADER);
-    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
-    header(
-        &top,
+    let (root, left, right) = page(
+        path,
         "Stability criteria against Floquet (undamped)",
         "error = larger |window end − Floquet's end| in m = A/ℓ; k < 0 inverted, k > 0 hanging",
     )?;
-    let mut chart = ChartBuilder::on(&left)
-        .margin(14)
-        .margin_right(24)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
+    let mut chart = builder(&left)
         .build_cartesian_2d(-1.0..1.0, (y0..y1).log_scale())
         .map_err(e)?;
     chart
@@ -353,7 +349,7 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
         .draw()
         .map_err(e)?;
     let mut entries = Vec::new();
-    for name in CRITERIA {
+    for name in Criterion::CHEAPER {
         let c = criterion_colour(name);
         for inverted in [true, false] {
             let pts: Vec<_> = rows
@@ -383,7 +379,7 @@ pub fn stability_error(path: &Path, r: &Results) -> Result<()> {
                 }
             }
         }
-        entries.push((criterion_label(name).to_string(), c, Mark::Solid));
+        entries.push((name.label().to_string(), c, Mark::Solid));
     }
     legend(
         &right,
@@ -409,7 +405,7 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
     let rows: Vec<_> = r
         .stability_criteria
         .iter()
-        .filter(|c| c.criterion != "floquet" && c.error.is_some_and(|x| x > 0.0))
+        .filter(|c| c.criterion != Criterion::Floquet && c.error.is_some_and(|x| x > 0.0))
         .collect();
     let fl = &r.floquet_convergence;
     let (x0, x1) = log_range(
@@ -424,20 +420,12 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
             .chain(fl.iter().filter_map(|f| f.error.map(|x| x.max(FLOOR)))),
         3.0,
     );
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(e)?;
-    let (top, body) = root.split_vertically(HEADER);
-    let (left, right) = body.split_horizontally(SIZE.0 - LEGEND);
-    header(
-        &top,
+    let (root, left, right) = page(
+        path,
         "Stability criteria: error against cost",
         "one point per k for each criterion; Floquet's own error against a finer Floquet as its RK4 steps per period grow",
     )?;
-    let mut chart = ChartBuilder::on(&left)
-        .margin(14)
-        .margin_right(24)
-        .x_label_area_size(50)
-        .y_label_area_size(80)
+    let mut chart = builder(&left)
         .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(e)?;
     chart
@@ -453,7 +441,7 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
         .draw()
         .map_err(e)?;
     let mut entries = Vec::new();
-    for name in CRITERIA {
+    for name in Criterion::CHEAPER {
         let c = criterion_colour(name);
         chart
             .draw_series(rows.iter().filter(|r| r.criterion == name).filter_map(|r| {
@@ -461,7 +449,7 @@ pub fn stability_cost(path: &Path, r: &Results) -> Result<()> {
                     .map(|x| Circle::new((r.seconds_per_eval, x), 5, c.filled()))
             }))
             .map_err(e)?;
-        entries.push((criterion_label(name).to_string(), c, Mark::Dot));
+        entries.push((name.label().to_string(), c, Mark::Dot));
     }
     let mut ks: Vec<f64> = fl.iter().map(|f| f.k).collect();
     ks.dedup();

@@ -18,6 +18,7 @@
 use serde::Serialize;
 
 use super::measure::{Family, Point};
+use kapitza_core::sim::Format;
 
 /// What a cost is measured in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,11 +68,8 @@ pub fn cost_at(curve: &[&Point], target: f64, c: Cost) -> Option<(f64, bool)> {
 }
 
 /// The curves of a scene: points grouped by (family, format).
-pub fn curves<'p>(
-    points: &'p [Point],
-    scene: &str,
-) -> Vec<((Family, &'static str), Vec<&'p Point>)> {
-    let mut out: Vec<((Family, &'static str), Vec<&Point>)> = Vec::new();
+pub fn curves<'p>(points: &'p [Point], scene: &str) -> Vec<((Family, Format), Vec<&'p Point>)> {
+    let mut out: Vec<((Family, Format), Vec<&Point>)> = Vec::new();
     for p in points.iter().filter(|p| p.scene == scene) {
         let key = (p.family, p.format);
         match out.iter_mut().find(|(k, _)| *k == key) {
@@ -82,7 +80,7 @@ pub fn curves<'p>(
     out
 }
 
-pub fn curve_label(family: Family, format: &str) -> String {
+pub fn curve_label(family: Family, format: Format) -> String {
     if family.is_peer() {
         family.label().to_string()
     } else {
@@ -167,15 +165,17 @@ pub fn peer_ratio(points: &[Point], scene: &str, target: f64, workaround: bool) 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::measure::{SettingName, Who};
+    use kapitza_core::sim::scene::Fidelity;
 
     fn pt(evals: u64, error: f64, wall_s: f64) -> Point {
         Point {
             scene: "s".into(),
             family: Family::Rk4,
-            who: "ours",
-            fidelity: "full",
-            format: "f64",
-            setting_name: "steps_per_period",
+            who: Who::Ours,
+            fidelity: Fidelity::Full,
+            format: Format::F64,
+            setting_name: SettingName::StepsPerPeriod,
             setting: 1.0,
             error,
             wall_s,

@@ -15,9 +15,10 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 use std::time::Duration;
 
-use super::clock;
-use kapitza_core::math;
+use super::measure::{self, Family};
+use crate::timing;
 use kapitza_core::sim::sampling::Discard;
+use kapitza_core::sim::scene::Fidelity;
 use kapitza_core::sim::{simulate, Controller, Method, Options, Scene};
 
 /// Simulated time (s).
@@ -29,12 +30,11 @@ const OMEGA: f64 = 330.0;
 /// One method's real-time factor.
 #[derive(Debug, Clone, Serialize)]
 pub struct RealTimeFactor {
-    /// `"full"` or `"averaged"`.
-    pub model: &'static str,
-    /// `"dop853"`, `"rkn86"` or `"rkn1210"`.
-    pub method: &'static str,
-    /// The step controller: `"standard"` or `"pi"`.
-    pub controller: &'static str,
+    /// Full or averaged.
+    pub model: Fidelity,
+    /// DOP853, RKN 8(6) or RKN 12(10).
+    pub method: Family,
+    pub controller: Controller,
     /// rtol = atol of the cheapest setting that reaches [`TARGET`].
     pub setting: f64,
     /// Its final error against the model's reference.
@@ -46,7 +46,7 @@ pub struct RealTimeFactor {
 }
 
 /// The shipped tilted scene with Q = 50 for 60 s: the `realtime` benchmark's scene.
-fn scene(fidelity: &str) -> Result<Scene> {
+fn scene(fidelity: Fidelity) -> Result<Scene> {
     let sets = [
         "effects.viscous.q=50",
         "run.periods=",
@@ -69,7 +69,7 @@ fn end(s: &Scene, method: Method, controller: Controller) -> Result<(f64, f64)> 
         ..Options::default()
     };
     let r = simulate(s, &options, &mut Discard).map_err(|e| anyhow!("{e}"))?;
-    Ok((r.end.1, r.end.2))
+    Ok(r.end.angle_rate())
 }
 
 /// Tolerances tried, loosest first.
@@ -79,23 +79,28 @@ const LADDER: [f64; 22] = [
 ];
 
 /// What is measured: (model, method, controller).
-pub const RECORDS: [(&str, &str, &str); 10] = [
-    ("full", "dop853", "standard"),
-    ("full", "dop853", "pi"),
-    ("full", "rkn86", "standard"),
-    ("full", "rkn1210", "standard"),
-    ("averaged", "dop853", "standard"),
-    ("averaged", "dop853", "pi"),
-    ("averaged", "rkn86", "standard"),
-    ("averaged", "rkn86", "pi"),
-    ("averaged", "rkn1210", "standard"),
-    ("averaged", "rkn1210", "pi"),
-];
+pub const RECORDS: [(Fidelity, Family, Controller); 10] = {
+    use Controller::{Pi, Standard};
+    use Family::{Dop853, Rkn1210, Rkn86};
+    use Fidelity::{Averaged, Full};
+    [
+        (Full, Dop853, Standard),
+        (Full, Dop853, Pi),
+        (Full, Rkn86, Standard),
+        (Full, Rkn1210, Standard),
+        (Averaged, Dop853, Standard),
+        (Averaged, Dop853, Pi),
+        (Averaged, Rkn86, Standard),
+        (Averaged, Rkn86, Pi),
+        (Averaged, Rkn1210, Standard),
+        (Averaged, Rkn1210, Pi),
+    ]
+};
 
 /// The factors of every [`RECORDS`] entry.
 pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<RealTimeFactor>> {
     let mut out = Vec::new();
-    for (model, name, controller_name) in RECORDS {
+    for (model, family, controller) in RECORDS {
         let s = scene(model)?;
         let reference = end(
             &s,
@@ -105,44 +110,29 @@ pub fn real_time_factors(batch: Duration, mut tick: impl FnMut()) -> Result<Vec<
             },
             Controller::Standard,
         )?;
-        let method = |tol: f64| match name {
-            "rkn86" => Method::Rkn86 {
-                rtol: tol,
-                atol: tol,
-            },
-            "rkn1210" => Method::Rkn1210 {
-                rtol: tol,
-                atol: tol,
-            },
-            _ => Method::Dop853 {
-                rtol: tol,
-                atol: tol,
-            },
-        };
-        let controller = if controller_name == "pi" {
-            Controller::Pi
-        } else {
-            Controller::Standard
+        let method = |tol: f64| {
+            family
+                .method(tol)
+                .ok_or_else(|| anyhow!("{family} is not one of ours"))
         };
         let mut found = None;
         for tol in LADDER {
-            let got = end(&s, method(tol), controller)?;
-            let error = math::wrap_pi(got.0 - reference.0)
-                .abs()
-                .max((got.1 - reference.1).abs() / OMEGA);
+            let got = end(&s, method(tol)?, controller)?;
+            let error = measure::error(got, reference, OMEGA);
             if error <= TARGET {
                 found = Some((tol, error));
                 break;
             }
         }
         let (tol, error) = found.ok_or_else(|| {
-            anyhow!("{model} {name} {controller_name}: no tolerance down to 1e-9 reaches 1e-6")
+            anyhow!("{model} {family} {controller}: no tolerance down to 1e-9 reaches 1e-6")
         })?;
-        let cost = clock::cost(batch, || end(&s, method(tol), controller));
+        let method = method(tol)?;
+        let cost = timing::cost(batch, || end(&s, method, controller));
         out.push(RealTimeFactor {
             model,
-            method: name,
-            controller: controller_name,
+            method: family,
+            controller,
             setting: tol,
             error,
             cpu_s: cost.cpu_s,

@@ -5,30 +5,12 @@ use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::measure::Point;
+use super::measure::{Point, SettingName};
 use super::physical::Choice;
 use super::ratio::{curve_label, curves, AtTarget, PeerRatio};
 use super::Results;
-
-fn num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        String::new()
-    }
-}
-
-fn opt(x: Option<f64>) -> String {
-    x.map_or(String::new(), num)
-}
-
-fn quote(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
+use crate::csv_out::{num, opt, quote};
+use kapitza_core::stability::Criterion;
 
 fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
@@ -220,7 +202,7 @@ pub fn secs(s: f64) -> String {
 }
 
 fn setting(p: &Point) -> String {
-    if p.setting_name == "rtol" {
+    if p.setting_name == SettingName::Rtol {
         format!("tol {}", sci(p.setting))
     } else {
         format!("{} steps/T", p.setting)
@@ -244,7 +226,7 @@ fn ratio(x: Option<f64>) -> String {
 }
 
 fn choice(c: &Choice) -> String {
-    let s = if c.setting_name == "rtol" {
+    let s = if c.setting_name == SettingName::Rtol {
         format!("tol {}", sci(c.setting))
     } else {
         format!("{} steps/T", c.setting)
@@ -466,8 +448,8 @@ pub fn markdown(r: &Results, command: &str) -> String {
     ks.dedup();
     for k in ks {
         let rows: Vec<_> = r.stability_criteria.iter().filter(|c| c.k == k).collect();
-        let get = |name: &str| rows.iter().find(|c| c.criterion == name);
-        let err = |name: &str| {
+        let get = |name: Criterion| rows.iter().find(|c| c.criterion == name);
+        let err = |name: Criterion| {
             get(name).map_or("—".into(), |c| {
                 let e = c.error.map_or("none".into(), sci);
                 if c.missing_end {
@@ -477,8 +459,8 @@ pub fn markdown(r: &Results, command: &str) -> String {
                 }
             })
         };
-        let cost = |name: &str| get(name).map_or("—".into(), |c| secs(c.seconds_per_eval));
-        let window = get("floquet").map_or("—".into(), |c| {
+        let cost = |name: Criterion| get(name).map_or("—".into(), |c| secs(c.seconds_per_eval));
+        let window = get(Criterion::Floquet).map_or("—".into(), |c| {
             format!(
                 "{} … {}",
                 c.lower.map_or("—".into(), |v| format!("{v:.6}")),
@@ -488,13 +470,13 @@ pub fn markdown(r: &Results, command: &str) -> String {
         let _ = writeln!(
             s,
             "| {k} | {window} | {} | {} | {} | {} / {} / {} / {} |",
-            err("averaging"),
-            err("mathieu"),
-            err("harmonic_balance"),
-            cost("averaging"),
-            cost("mathieu"),
-            cost("harmonic_balance"),
-            cost("floquet")
+            err(Criterion::Averaging),
+            err(Criterion::Mathieu),
+            err(Criterion::HarmonicBalance),
+            cost(Criterion::Averaging),
+            cost(Criterion::Mathieu),
+            cost(Criterion::HarmonicBalance),
+            cost(Criterion::Floquet)
         );
     }
 

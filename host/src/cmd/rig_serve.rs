@@ -134,7 +134,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let start = Instant::now();
     let stop =
         || rigmod::interrupted() || duration.is_some_and(|d| start.elapsed().as_secs_f64() >= d);
-    let cpu0 = crate::bench::clock::thread_cpu();
+    let cpu0 = crate::timing::thread_cpu();
     let summary = simhost::run(
         opts.build(),
         opts.speed,
@@ -147,7 +147,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         let _ = std::fs::remove_file(link);
     }
     let s = summary?;
-    let cpu = crate::bench::clock::thread_cpu() - cpu0;
+    let cpu = crate::timing::thread_cpu() - cpu0;
     eprintln!(
         "rig serve: {:.1} rig seconds in {:.1} s ({:.1}× real time), {:.1} % of one core",
         s.rig_seconds,

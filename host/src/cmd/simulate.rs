@@ -104,7 +104,7 @@ pub struct Summary {
     pub atol: Option<f64>,
     pub steps_per_period: Option<f64>,
     /// `"f64"` or `"f32"`.
-    pub format: &'static str,
+    pub format: Format,
     /// R = A²ω²/(2 g_eff ℓ) at the set point.
     pub r: f64,
     /// R of the averaged theory: R (1 + A²/(4b²)) with a slider-crank of rod length b, else R.
@@ -143,7 +143,7 @@ pub struct FidelityOut {
     /// What the scene asked for: `"auto"`, `"full"`, `"averaged"` or `"linearised"`.
     pub requested: &'static str,
     /// What ran.
-    pub used: &'static str,
+    pub used: Fidelity,
     pub reason: String,
 }
 
@@ -165,14 +165,6 @@ pub struct EndOut {
     /// Turns completed, from the unwrapped angle (rounded towards zero).
     pub turns: i64,
     pub rate: f64,
-}
-
-fn fidelity_name(f: Fidelity) -> &'static str {
-    match f {
-        Fidelity::Full => "full",
-        Fidelity::Averaged => "averaged",
-        Fidelity::Linearised => "linearised",
-    }
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
@@ -274,7 +266,11 @@ fn summarise(
             (name, None, None, Some(steps_per_period))
         }
     };
-    let (t_end, theta_end, rate_end) = report.end;
+    let kapitza_core::sim::EndState {
+        t: t_end,
+        theta: theta_end,
+        rate: rate_end,
+    } = report.end;
     Ok(Summary {
         scene: name.to_string(),
         title: file.title.clone(),
@@ -284,19 +280,16 @@ fn summarise(
         fidelity: FidelityOut {
             requested: match scene.fidelity {
                 FidelityChoice::Auto => "auto",
-                FidelityChoice::Fixed(f) => fidelity_name(f),
+                FidelityChoice::Fixed(f) => f.name(),
             },
-            used: fidelity_name(report.decision.fidelity),
+            used: report.decision.fidelity,
             reason: report.decision.to_string(),
         },
         method,
         rtol,
         atol,
         steps_per_period,
-        format: match file.format {
-            Format::F64 => "f64",
-            Format::F32 => "f32",
-        },
+        format: file.format,
         r: p.r,
         r_effective,
         omega: p.omega,
@@ -462,7 +455,7 @@ fn write_out(dir: &Path, file: &SceneFile, s: &Summary, rec: &Collect) -> Result
             .as_slice()
             .map(|e| (outcome::deg(e.angle), e.stability))
             .collect(),
-        averaged: s.fidelity.used == "averaged",
+        averaged: s.fidelity.used == Fidelity::Averaged,
     };
     plot::angle_png(&path("angle.png"), &input)?;
     plot::phase_png(&path("phase.png"), &input)?;

@@ -244,9 +244,10 @@ mod tests {
     #[test]
     fn horizontal_drive() {
         // physics §4.5: R = 1.75, θd = 90° → stable φ0 = ±arccos(1/R) = ±55.15°.
-        let e = eq(1.75, 90.0);
-        let want = math::to_deg(math::acos(1.0 / 1.75));
-        assert!((want - 55.15).abs() < 0.005);
+        let c = crate::cases::HORIZONTAL_1_75;
+        let e = eq(c.r, c.drive_angle_deg);
+        let want = math::to_deg(math::acos(1.0 / c.r));
+        assert!((want - c.stable_deg.value).abs() < c.stable_deg.half_ulp);
         let s: [f64; 2] = {
             let mut it = stable_deg(&e);
             [it.next().unwrap(), it.next().unwrap()]

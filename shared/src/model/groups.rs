@@ -111,10 +111,11 @@ mod tests {
     fn spec_rod_example() {
         // physics §4.5: rod L = 0.25 m, A = 0.0127 m, ω = 188 rad/s, g = 9.81 → R = 1.7433
         // (closed form 3A²ω²/(4gL) = 1.74332…; tolerance 5e-5 covers the 4 printed decimals).
-        let ell = 2.0 * 0.25 / 3.0;
-        let g = Groups::new(ell, 9.81, 0.0127, 188.0, 0.0).unwrap();
-        assert!((g.r - 1.7433).abs() < 5e-5, "R = {}", g.r);
-        let closed = 3.0 * 0.0127f64.powi(2) * 188.0f64.powi(2) / (4.0 * 9.81 * 0.25);
+        let c = crate::cases::DEMO_ROD;
+        let ell = 2.0 * c.length / 3.0;
+        let g = Groups::new(ell, c.gravity, c.amplitude, c.omega, 0.0).unwrap();
+        assert!((g.r - c.r.value).abs() < c.r.half_ulp, "R = {}", g.r);
+        let closed = 3.0 * c.amplitude.powi(2) * c.omega.powi(2) / (4.0 * c.gravity * c.length);
         assert!((g.r - closed).abs() < 1e-12);
     }
 

@@ -17,7 +17,7 @@
 //! Hermite interpolant ([`Span`]), without evaluations.
 
 use super::eom::{AveragedEom, FullEom, NoExtra};
-use super::run::{Context, RunOut, SimError};
+use super::run::{Context, EndState, RunOut, SimError};
 use super::sampling::{Interpolant, Recorder};
 use super::signal::DriveSignal;
 use super::turns::{Shifted, Turns};
@@ -156,7 +156,11 @@ pub(super) fn run<'r, R: Real, A: Accel<R>, Rec: Recorder, const S: usize>(
     Ok(RunOut {
         sampler,
         work,
-        end: (t, y.0.to_f64() + turns.offset(), y.1.to_f64()),
+        end: EndState {
+            t,
+            theta: y.0.to_f64() + turns.offset(),
+            rate: y.1.to_f64(),
+        },
         sticks: None,
     })
 }

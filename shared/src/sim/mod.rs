@@ -73,6 +73,8 @@ mod turns;
 pub mod wobble;
 
 pub use classify::Outcome;
-pub use run::{simulate, Controller, Format, Method, Options, Report, SimError};
+pub use run::{
+    simulate, Controller, EndState, Format, Method, Options, PlannedRun, Report, SimError,
+};
 pub use sampling::Recorder;
 pub use scene::Scene;

@@ -5,6 +5,7 @@
 
 use crate::model::{DriveAngle, Geometry};
 use core::fmt;
+use serde::Serialize;
 
 /// How the drive frequency is given: ω itself, or R (then ω = ωc √R with the effective gravity).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,11 +59,29 @@ pub struct Effects {
 }
 
 /// Which equation to integrate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Fidelity {
     Full,
     Averaged,
     Linearised,
+}
+
+impl Fidelity {
+    /// As scene files spell it: `full`, `averaged`, `linearised`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fidelity::Full => "full",
+            Fidelity::Averaged => "averaged",
+            Fidelity::Linearised => "linearised",
+        }
+    }
+}
+
+impl fmt::Display for Fidelity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// The fidelity a scene asks for; `Auto` picks the cheapest valid one and says why.
@@ -154,6 +173,31 @@ fn pendulum_key(name: &str) -> &'static str {
 }
 
 impl Scene {
+    /// A canonical scene from its numbers, run for `length` on the given equation.
+    pub fn from_case(
+        c: &crate::cases::SceneCase,
+        length: RunLength,
+        fidelity: Fidelity,
+    ) -> Result<Scene, crate::error::ParamError> {
+        Ok(Scene {
+            pendulum: Geometry::rod(c.rod_length)?,
+            drive: DriveSpec {
+                amplitude: c.amplitude,
+                frequency: DriveFrequency::Omega(c.omega),
+                angle: DriveAngle::from_deg(c.drive_angle_deg)?,
+            },
+            gravity: c.gravity,
+            initial_angle: crate::math::to_rad(c.initial_angle_deg),
+            initial_rate: c.initial_rate,
+            length,
+            fidelity: FidelityChoice::Fixed(fidelity),
+            effects: Effects {
+                viscous: Some(Viscous::Q(c.q)),
+                ..Effects::default()
+            },
+        })
+    }
+
     /// Checks every number once; nothing runs on a scene that fails.
     pub fn check(&self) -> Result<(), SceneError> {
         let d = &self.drive;

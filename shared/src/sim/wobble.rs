@@ -145,15 +145,17 @@ mod tests {
         angle: DriveAngle,
     }
 
+    /// The tilted example scene's drive and pendulum ([`crate::cases::TILTED_135`]).
     fn tilted() -> Tilted {
-        let ell = 2.0 * 0.20 / 3.0;
-        let (a1, omega, g) = (0.0089 / ell, 330.0, 9.81);
+        let c = crate::cases::TILTED_135;
+        let ell = 2.0 * c.rod_length / 3.0;
+        let (a1, omega, g) = (c.amplitude / ell, c.omega, c.gravity);
         Tilted {
             a1,
             omega,
             omega0_sq: g / ell,
             r: a1 * a1 * omega * omega / (2.0 * g / ell),
-            angle: DriveAngle::from_deg(135.0).unwrap(),
+            angle: DriveAngle::from_deg(c.drive_angle_deg).unwrap(),
         }
     }
 
@@ -252,7 +254,7 @@ mod tests {
         let s = tilted();
         let w = Wobble {
             a1: s.a1,
-            a2: s.a1 * 0.0089 / (4.0 * 0.05),
+            a2: s.a1 * crate::cases::TILTED_135.amplitude / (4.0 * 0.05),
             omega: s.omega,
             c: 0.5,
             angle: s.angle,

@@ -53,11 +53,15 @@ mod tests {
     #[test]
     fn spec_table_values() {
         // physics §4.5, k = −0.3: √(−2k) = √0.6 = 0.7746, printed 0.775 (3 decimals).
-        assert!((lower(-0.3).unwrap() - 0.775).abs() < 5e-4);
+        let c = crate::cases::K_MINUS_0_3;
+        let printed = c.conventional_lower.unwrap();
+        assert!((lower(c.k).unwrap() - printed.value).abs() < printed.half_ulp);
         // physics §4.5, Landau row: g = 9.81, l = 1 m, ω = 9 rad/s: k = −g/(lω²), and the
         // bound on the amplitude a = m·l is √(2g/(lω²)) = 0.4922, printed 0.492.
-        let k = -9.81 / (1.0 * 81.0);
-        assert!((lower(k).unwrap() - 0.492).abs() < 5e-4);
+        let l = crate::cases::LANDAU;
+        let k = -l.gravity / (l.length * l.omega * l.omega);
+        let a = lower(k).unwrap() * l.length;
+        assert!((a - l.lower_amplitude.value).abs() < l.lower_amplitude.half_ulp);
         assert_eq!(lower(0.2).unwrap(), 0.0);
     }
 

@@ -44,12 +44,14 @@
 //! e^(2π·(|k| + m + δ)) ≤ e^(2π·75) ≈ 1e204), and are far beyond the rig's range (|k| ≪ 1).
 
 pub mod averaging;
+pub mod criterion;
 pub mod floquet;
 pub mod harmonic_balance;
 pub mod hill;
 pub mod mathieu;
 
 use crate::error::ParamError;
+pub use criterion::{Criterion, Position};
 
 /// Largest |k| accepted.
 pub const K_MAX: f64 = 25.0;

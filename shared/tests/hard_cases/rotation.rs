@@ -119,14 +119,14 @@ fn check_long(name: &str, periods: f64, options: Options, orbit: &Orbit, tol: f6
         "{name}: {:.2} h, {:.0} turns, off the orbit by {off_orbit:.2e}, unwrapped growth over \
          1000 periods off by {growth:.2e} rad, end time − t_end = {:.1e} s, {} evaluations",
         t_end / 3600.0,
-        long.end.1 / math::TAU,
-        long.end.0 - t_end,
+        long.end.theta / math::TAU,
+        long.end.t - t_end,
         long.work.rhs_evals
     );
     assert!(off_orbit < tol, "{name}: off the orbit by {off_orbit:e}");
     assert!(growth.abs() < tol, "{name}: growth off by {growth:e}");
     let ulp = f64::EPSILON * t_end;
-    assert!((long.end.0 - t_end).abs() <= 2.0 * ulp, "{name}: end time");
+    assert!((long.end.t - t_end).abs() <= 2.0 * ulp, "{name}: end time");
 }
 
 /// 2.0 hours: 344 000 periods of 20.9 ms.

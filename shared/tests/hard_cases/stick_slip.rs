@@ -108,7 +108,7 @@ fn hc03_undriven_sticks_once_where_friction_holds_it() {
         assert!((g - w).abs() < 1e-7, "turning point {g} vs {w}");
     }
     // Stuck where static friction holds it.
-    let (_, theta_end, rate_end) = report.end;
+    let (theta_end, rate_end) = report.end.angle_rate();
     assert_eq!(rate_end, 0.0);
     assert!(
         W0SQ * math::sin(theta_end).abs() <= MU,

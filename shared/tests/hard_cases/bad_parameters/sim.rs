@@ -314,7 +314,7 @@ proptest! {
             }
             Ok(r) => {
                 let p = r.physical;
-                finite("report", &[r.duration, r.end.0, r.end.1, r.end.2, p.ell, p.omega0,
+                finite("report", &[r.duration, r.end.t, r.end.theta, r.end.rate, p.ell, p.omega0,
                                    p.omega, p.r, p.c])?;
                 finite("outcome", &outcome_floats(&r.outcome))?;
                 prop_assert!(rec.first_bad.is_none(), "recorder saw {:?}", rec.first_bad);
@@ -360,7 +360,7 @@ proptest! {
                 "{e}"
             ),
             Ok(r) => {
-                finite("report", &[r.end.0, r.end.1, r.end.2])?;
+                finite("report", &[r.end.t, r.end.theta, r.end.rate])?;
                 prop_assert!(rec.first_bad.is_none(), "recorder saw {:?}", rec.first_bad);
             }
         }

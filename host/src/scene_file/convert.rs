@@ -1,20 +1,13 @@
-//! Scene files: TOML text → the core's [`Scene`], the run options and the `[expect]` table.
-//!
-//! Reading goes in three steps, each with errors that name the file and the key:
-//! 1. the text parses as TOML into a table (syntax errors carry the line);
-//! 2. `--set KEY=VALUE` overrides are written into that table at their dotted paths;
-//! 3. the table deserialises into raw structs (`deny_unknown_fields` everywhere, so a misspelt key
-//!    or an unknown effect is an error listing the allowed ones), which are converted to SI units
-//!    and radians and checked: by hand where two keys interact, by [`Scene::check`] for ranges,
-//!    and by the fidelity decision, so that nothing runs on a bad scene.
-//!
-//! The keys, their units, defaults and ranges are documented in `docs/scenes.md`.
+//! The raw file converted to SI units, radians and the core's types, and checked: by hand where
+//! two keys interact, by [`Scene::check`] for ranges, and by the fidelity decision, so that
+//! nothing runs on a bad scene.
 
-use anyhow::{anyhow, bail, Context, Result};
-use serde::Deserialize;
-use std::path::Path;
+use anyhow::{anyhow, bail, Result};
 
+use super::raw::*;
+use super::{SceneFile, DEFAULT_RK4_STEPS};
 use crate::outcome::{Expect, ExpectKind};
+use kapitza_core::error::Range;
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::model::{DriveAngle, Geometry};
@@ -23,339 +16,6 @@ use kapitza_core::sim::scene::{
 };
 use kapitza_core::sim::{fidelity, Controller, Format, Method, Scene};
 use kapitza_core::ParamError;
-
-/// RK4 steps per drive period when `run.steps_per_period` is not given.
-pub const DEFAULT_RK4_STEPS: f64 = 200.0;
-
-/// A loaded, checked scene file.
-#[derive(Debug, Clone)]
-pub struct SceneFile {
-    /// `title`, or the file's stem when the file has none.
-    pub title: String,
-    pub scene: Scene,
-    pub method: Method,
-    /// The adaptive method's step controller (`run.controller`).
-    pub controller: Controller,
-    pub format: Format,
-    /// Seed of the sensor noise.
-    pub seed: u64,
-    pub expect: Option<Expect>,
-}
-
-/// Reads, overrides (`sets`: `KEY=VALUE` strings) and checks a scene file.
-pub fn load(path: &Path, sets: &[String]) -> Result<SceneFile> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).with_context(|| format!("{name}: cannot read"))?;
-    let stem = path
-        .file_stem()
-        .map_or_else(|| name.clone(), |s| s.to_string_lossy().into_owned());
-    parse(&text, &name, &stem, sets)
-}
-
-/// [`load`] on text already read: `name` prefixes every error, `stem` is the default title.
-pub fn parse(text: &str, name: &str, stem: &str, sets: &[String]) -> Result<SceneFile> {
-    let mut table: toml::Table = toml::from_str(text)
-        .map_err(|e| anyhow!("{}", e.to_string().trim_end()))
-        .with_context(|| format!("{name}: not valid TOML"))?;
-    let mut set_keys = Vec::new();
-    for s in sets {
-        set_keys.push(apply_set(&mut table, s).with_context(|| name.to_string())?);
-    }
-    let raw: RawScene =
-        serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
-            let path = e.path().to_string();
-            let origin = set_keys
-                .iter()
-                .find(|(k, _)| within(&path, k) || within(k, &path))
-                .map_or(String::new(), |(_, s)| format!(" (from --set {s})"));
-            let at = if path == "." {
-                String::new()
-            } else {
-                format!("{path}: ")
-            };
-            anyhow!("{name}: {at}{}{origin}", e.inner().message().trim_end())
-        })?;
-    convert(raw, stem).with_context(|| name.to_string())
-}
-
-/// Whether the dotted path `inner` is `outer` or lies under it.
-fn within(inner: &str, outer: &str) -> bool {
-    inner
-        .strip_prefix(outer)
-        .is_some_and(|rest| rest.is_empty() || rest.starts_with('.'))
-}
-
-/// Writes one `--set KEY=VALUE` into the table; returns the key and the assignment.
-///
-/// VALUE is a TOML value (`120`, `1e-3`, `true`, `"quoted string"`, `{ q = 50 }`); a bare word
-/// that is not a TOML value (`full`, `dop853`) is taken as a string; an empty VALUE removes the
-/// key (if it is there).
-pub fn apply_set(table: &mut toml::Table, assignment: &str) -> Result<(String, String)> {
-    let Some((key, text)) = assignment.split_once('=') else {
-        bail!("--set {assignment}: expected KEY=VALUE, e.g. --set drive.angle_deg=120");
-    };
-    let (key, text) = (key.trim(), text.trim());
-    let parts: Vec<&str> = key.split('.').collect();
-    let bare = |s: &str| {
-        !s.is_empty()
-            && s.chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-    };
-    if !parts.iter().all(|p| bare(p)) {
-        bail!("--set {assignment}: key `{key}` is not a dotted path of bare keys (like effects.viscous.q)");
-    }
-    let (last, path) = parts.split_last().expect("split yields at least one part");
-    if text.is_empty() {
-        // KEY= removes the key, e.g. to give omega in a scene that gives r.
-        let mut here = Some(&mut *table);
-        for part in path {
-            here = here
-                .and_then(|t| t.get_mut(*part))
-                .and_then(|v| v.as_table_mut());
-        }
-        if let Some(t) = here {
-            t.remove(*last);
-        }
-        return Ok((key.to_string(), assignment.to_string()));
-    }
-    let value = match toml::from_str::<toml::Table>(&format!("v = {text}")) {
-        Ok(mut t) if t.len() == 1 => t.remove("v").expect("the one key is v"),
-        _ if bare(text) => toml::Value::String(text.to_string()),
-        _ => bail!(
-            "--set {assignment}: `{text}` is not a TOML value (numbers, true/false, \"quoted strings\", {{ inline = tables }}; a bare word is a string)"
-        ),
-    };
-    let mut here = table;
-    for (i, part) in path.iter().enumerate() {
-        let entry = here
-            .entry(part.to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        here = match entry {
-            toml::Value::Table(t) => t,
-            other => bail!(
-                "--set {assignment}: `{}` is a {}, not a table, so it has no key `{}`",
-                parts[..=i].join("."),
-                other.type_str(),
-                parts[i + 1]
-            ),
-        };
-    }
-    here.insert(last.to_string(), value);
-    Ok((key.to_string(), assignment.to_string()))
-}
-
-// ---------------------------------------------------------------------------------------------
-// The file as written.
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a scene table")]
-struct RawScene {
-    title: Option<String>,
-    pendulum: RawPendulum,
-    drive: RawDrive,
-    #[serde(default)]
-    environment: RawEnvironment,
-    #[serde(default)]
-    initial: RawInitial,
-    run: RawRun,
-    #[serde(default)]
-    effects: RawEffects,
-    expect: Option<RawExpect>,
-}
-
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub(crate) enum GeometryName {
-    Rod,
-    Point,
-    General,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: [pendulum]")]
-pub(crate) struct RawPendulum {
-    geometry: GeometryName,
-    length: Option<f64>,
-    inertia: Option<f64>,
-    mass: Option<f64>,
-    com: Option<f64>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: [drive]")]
-struct RawDrive {
-    amplitude: f64,
-    omega: Option<f64>,
-    r: Option<f64>,
-    angle_deg: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: [environment]")]
-pub(crate) struct RawEnvironment {
-    #[serde(default = "standard_gravity")]
-    pub(crate) gravity: f64,
-}
-
-fn standard_gravity() -> f64 {
-    9.81
-}
-
-impl Default for RawEnvironment {
-    fn default() -> Self {
-        Self {
-            gravity: standard_gravity(),
-        }
-    }
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: [initial]")]
-struct RawInitial {
-    #[serde(default)]
-    angle_deg: f64,
-    #[serde(default)]
-    rate: f64,
-}
-
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum FidelityName {
-    Full,
-    Averaged,
-    Linearised,
-    #[default]
-    Auto,
-}
-
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum MethodName {
-    #[default]
-    Auto,
-    Dop853,
-    Rkn86,
-    Rkn1210,
-    Rk4,
-    Verlet,
-    Yoshida4,
-    Yoshida6,
-}
-
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum ControllerName {
-    #[default]
-    Standard,
-    Pi,
-}
-
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum FormatName {
-    #[default]
-    F64,
-    F32,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: [run]")]
-struct RawRun {
-    periods: Option<f64>,
-    duration: Option<f64>,
-    #[serde(default)]
-    fidelity: FidelityName,
-    #[serde(default)]
-    method: MethodName,
-    rtol: Option<f64>,
-    atol: Option<f64>,
-    steps_per_period: Option<f64>,
-    #[serde(default)]
-    controller: ControllerName,
-    #[serde(default)]
-    format: FormatName,
-    seed: Option<u64>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table of effects")]
-struct RawEffects {
-    viscous: Option<RawViscous>,
-    coulomb: Option<RawCoulomb>,
-    tilt: Option<RawTilt>,
-    slider_crank: Option<RawSliderCrank>,
-    ramp: Option<RawRamp>,
-    sensor: Option<RawSensor>,
-    actuator: Option<RawActuator>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table: viscous = { q = … } or { gamma = … }"
-)]
-struct RawViscous {
-    q: Option<f64>,
-    gamma: Option<f64>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: coulomb = { torque = … }")]
-struct RawCoulomb {
-    torque: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: tilt = { angle_deg = … }")]
-struct RawTilt {
-    angle_deg: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table: slider_crank = { rod_length = … }"
-)]
-struct RawSliderCrank {
-    rod_length: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: ramp = { seconds = … }")]
-struct RawRamp {
-    seconds: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(
-    deny_unknown_fields,
-    expecting = "a table: sensor = { bits = …, noise_deg = …, rate_hz = … }"
-)]
-struct RawSensor {
-    bits: u32,
-    #[serde(default)]
-    noise_deg: f64,
-    rate_hz: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: actuator = { lag_s = … }")]
-struct RawActuator {
-    lag_s: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, expecting = "a table: [expect]")]
-struct RawExpect {
-    kind: ExpectKind,
-    angle_deg: Option<f64>,
-    tolerance_deg: Option<f64>,
-    order: Option<u32>,
-    direction: Option<i64>,
-}
-
-// ---------------------------------------------------------------------------------------------
-// Conversion and checks.
 
 /// `key = value` is out of range.
 pub(crate) fn out_of_range(
@@ -366,20 +26,21 @@ pub(crate) fn out_of_range(
     anyhow!("{key} = {value} is out of range: allowed {allowed}")
 }
 
-fn finite(key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() {
+/// `v` if `range` admits it, else an error naming the scene key.
+fn in_range(key: &str, v: f64, range: Range) -> Result<f64> {
+    if range.admits(v) {
         Ok(v)
     } else {
-        Err(out_of_range(key, v, "a finite number"))
+        Err(out_of_range(key, v, range.allowed()))
     }
 }
 
+fn finite(key: &str, v: f64) -> Result<f64> {
+    in_range(key, v, Range::Finite)
+}
+
 fn non_negative(key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(out_of_range(key, v, "a finite number >= 0"))
-    }
+    in_range(key, v, Range::NonNegative)
 }
 
 /// A core constructor's [`ParamError`] in terms of the scene key it came from.
@@ -387,7 +48,7 @@ fn param(key: &str, e: ParamError) -> anyhow::Error {
     out_of_range(key, e.value, e.allowed)
 }
 
-fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
+pub(super) fn convert(raw: RawScene, stem: &str) -> Result<SceneFile> {
     let pendulum = pendulum(&raw.pendulum)?;
     let d = &raw.drive;
     let frequency = match (d.omega, d.r) {
