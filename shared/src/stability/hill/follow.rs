@@ -27,8 +27,9 @@ const ULPS: f64 = 16.0;
 /// Allowance for the error of the computed slope dλ/dq (≈ |λ''|·1e-9·|λ|).
 const SLOPE_SLACK: f64 = 1e-6;
 
-/// Newton steps in q on det(B(q) − aI) inside the bracket [lo, hi], where the block count at a is `c_lo`
-/// at lo and differs at hi; returns the crossing to within `tol_q` and adds the passes spent.
+/// Newton steps in q on det(B(q) − aI) inside the bracket [lo, hi], where the block count at a
+/// is `c_lo` at lo and differs at hi; returns the crossing to within `tol_q` (the converged
+/// Newton iterate, far closer, where it lies in the final bracket) and adds the passes spent.
 pub fn root_in(
     fam: Family,
     a: f64,
@@ -44,6 +45,7 @@ pub fn root_in(
         lo + 0.5 * (hi - lo)
     };
     let mut last_step = hi - lo;
+    let mut converged = None;
     for _ in 0..300 {
         let p = fam.factor(x, a, rows_for(a, x));
         *passes += 1;
@@ -60,6 +62,7 @@ pub fn root_in(
         let mut next = x + step;
         if step.abs() < 0.25 * tol_q && !p.degenerate {
             // Converged: straddle the root so that the next count closes the bracket.
+            converged = Some(next);
             next += if below { 0.5 * tol_q } else { -0.5 * tol_q };
         }
         let mid = lo + 0.5 * (hi - lo);
@@ -72,7 +75,10 @@ pub fn root_in(
         last_step = (next - x).abs();
         x = next;
     }
-    lo + 0.5 * (hi - lo)
+    match converged {
+        Some(r) if r >= lo && r <= hi => r,
+        _ => lo + 0.5 * (hi - lo),
+    }
 }
 
 /// The result of a walk: where the tracked value first meets a (to within tol), if before the
