@@ -89,11 +89,13 @@ fn main() {
         let ks_above: Vec<f64> = above.iter().step_by(16).copied().collect();
         report(
             &format!("damped Q = {q}, k ∈ [−5, 0.24]"),
+            "tr M_u",
             &ks_below,
             damped,
         );
         report(
             &format!("damped Q = {q}, k ∈ [0.26, 25]"),
+            "tr M_u",
             &ks_above,
             damped,
         );
