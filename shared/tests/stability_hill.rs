@@ -159,10 +159,10 @@ fn point_verdicts_match_monodromy_on_a_grid() {
 }
 
 #[test]
-fn bisected_first_window_agrees_with_the_walk() {
-    // Below the first tongue, first_window bisects the counts C ≥ 1, C ≥ 2, relying on a₀ and
-    // b₁ decreasing in q; the walk follows every crossing without that assumption. They must
-    // find the same ends (to the tolerance, 1e-10).
+fn newton_first_window_agrees_with_the_walk() {
+    // Below the first tongue, first_window finds where a₀ and b₁ meet a by Newton steps in q,
+    // relying on both decreasing in q; the walk follows every crossing without that
+    // assumption. They must find the same ends (to the tolerance, 1e-10).
     for i in 0..=40 {
         let k = -3.0 + 3.2 * f64::from(i) / 40.0;
         let (w, _, _) = hill::first_window(k, 10.0, 1e-12).unwrap();
