@@ -10,6 +10,8 @@
 //!
 //! Run: `cargo bench -p kapitza-core --bench realtime`. Figures: docs/performance.md.
 
+mod support;
+
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use kapitza_core::cases::{self, SceneCase};
 use kapitza_core::math;
@@ -17,6 +19,7 @@ use kapitza_core::sim::sampling::Discard;
 use kapitza_core::sim::scene::{Fidelity, RunLength};
 use kapitza_core::sim::{simulate, Controller, Method, Options, Scene};
 use std::time::Instant;
+use support::thread_cpu_seconds;
 
 const SIMULATED: f64 = 60.0;
 const TARGET: f64 = 1e-6;
@@ -51,19 +54,6 @@ fn error(a: (f64, f64), b: (f64, f64), omega: f64) -> f64 {
     math::wrap_pi(a.0 - b.0)
         .abs()
         .max((a.1 - b.1).abs() / omega)
-}
-
-/// CPU time of this thread (s): unlike wall time, other processes on a shared machine do not
-/// inflate it.
-fn thread_cpu_seconds() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: clock_gettime writes one timespec through a valid pointer.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    assert_eq!(rc, 0, "CLOCK_THREAD_CPUTIME_ID unavailable");
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
 /// Median (over 7 runs) wall and thread-CPU seconds of one run.

@@ -159,10 +159,10 @@ fn point_verdicts_match_monodromy_on_a_grid() {
 }
 
 #[test]
-fn bisected_first_window_agrees_with_the_walk() {
-    // Below the first tongue, first_window bisects the counts C ≥ 1, C ≥ 2, relying on a₀ and
-    // b₁ decreasing in q; the walk follows every crossing without that assumption. They must
-    // find the same ends (to the tolerance, 1e-10).
+fn newton_first_window_agrees_with_the_walk() {
+    // Below the first tongue, first_window finds where a₀ and b₁ meet a by Newton steps in q,
+    // relying on both decreasing in q; the walk follows every crossing without that
+    // assumption. They must find the same ends (to the tolerance, 1e-10).
     for i in 0..=40 {
         let k = -3.0 + 3.2 * f64::from(i) / 40.0;
         let (w, _, _) = hill::first_window(k, 10.0, 1e-12).unwrap();
@@ -189,4 +189,59 @@ fn bisected_first_window_agrees_with_the_walk() {
             "k {k}: {w:?} {upper:?}"
         );
     }
+}
+
+/// The first window's upper end by the walk over every crossing (the first stable → unstable
+/// transition), with whether it is a flutter boundary.
+fn walked_upper(k: f64, m_max: f64, tol: f64) -> Option<(f64, bool)> {
+    hill::Windows::new(k, m_max, tol)
+        .unwrap()
+        .find(|t| t.stable_before() && !t.stable_after())
+        .map(|t| (t.m, t.flutter))
+}
+
+#[test]
+fn followed_first_window_agrees_with_the_walk_above_the_first_tongue() {
+    // k ≥ 1/4: first_window follows only aⱼ and bⱼ₊₁; the walk certifies every crossing of every
+    // value. Same upper end (to 1e-10; tolerance 1e-12) and the same kind of end, on a sweep
+    // that avoids the tongue tips k = j²/4.
+    for i in 0..=60 {
+        let k = 0.26 + 0.1963 * f64::from(i);
+        let (w, flutter, _) = hill::first_window(k, 10.0, 1e-12).unwrap();
+        assert_eq!(val(w.lower), 0.0);
+        match walked_upper(k, 10.0, 1e-12) {
+            Some((m, f)) => {
+                assert!((val(w.upper) - m).abs() < 1e-10, "k {k}: {w:?} vs {m}");
+                assert_eq!(flutter, f, "k {k}");
+            }
+            None => assert!(w.upper.value().is_none(), "k {k}: {w:?}"),
+        }
+    }
+}
+
+#[test]
+fn tongue_tips() {
+    // k = 1/4 and 1 (a = 1, 4): the tongue leaves m = 0 at once (a₁, b₁ = 1 ± q; a₂, b₂ =
+    // 4 + 5q²/12, 4 − q²/12: A&S 20.2.25), so the window is exactly [0, 0].
+    for (k, flutter) in [(0.25, true), (1.0, false)] {
+        let (w, f, _) = hill::first_window(k, 10.0, 1e-12).unwrap();
+        assert_eq!(
+            (val(w.lower), val(w.upper), f),
+            (0.0, 0.0, flutter),
+            "k {k}"
+        );
+    }
+    // k = 9/4, 4, 25/4: both values of the tip rise, and the window is the limit from below
+    // (computed without the tip's special start), to 1e-7 (the window's end moves by
+    // ≈ |dm/dk|·1e-9 ≪ 1e-7); the k = 9/4 end also brackets a monodromy boundary.
+    for k in [2.25, 4.0, 6.25] {
+        let (w, _, _) = hill::first_window(k, 10.0, 1e-12).unwrap();
+        let (near, _, _) = hill::first_window(k - 1e-9, 10.0, 1e-12).unwrap();
+        match (w.upper.value(), near.upper.value()) {
+            (Some(a), Some(b)) => assert!((a - b).abs() < 1e-7, "k {k}: {a} vs {b}"),
+            (a, b) => assert_eq!(a, b, "k {k}"),
+        }
+    }
+    let (w, _, _) = hill::first_window(2.25, 10.0, 1e-13).unwrap();
+    brackets(2.25, 0.0, val(w.upper));
 }

@@ -99,7 +99,7 @@ fn floquet_matches_the_printed_boundaries() {
         .unwrap()
         .matches(num(&f["upper_m"])));
     assert_eq!(f["includes_damping"], true);
-    // Undamped, the ends come from Sturm counts of Hill's matrices: work, but no integration.
+    // Undamped, the ends come from passes over Hill's matrices: work, but no integration.
     assert!(num(&f["sturm_counts"]) > 0.0);
     assert_eq!(num(&f["monodromies"]), 0.0);
     let v = boundary(&["--k", "0"]);

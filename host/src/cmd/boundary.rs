@@ -134,7 +134,8 @@ pub struct Criterion {
     pub monodromies: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rhs_evals: Option<u64>,
-    /// Floquet only: Sturm counts of Hill's tridiagonal matrices one window took.
+    /// Floquet only: LDLᵀ passes over Hill's tridiagonal blocks (Sturm counts and Newton
+    /// steps) one window took.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sturm_counts: Option<u64>,
 }

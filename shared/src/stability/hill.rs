@@ -26,8 +26,12 @@
 //!
 //! and C comes from a Sturm sequence (the signs of the pivots of the LDLᵀ factorisation of
 //! T − aI; Wilkinson, *The Algebraic Eigenvalue Problem*, §5.37): no integration, no scan. A
-//! boundary is where one characteristic value crosses a: [`windows`] finds each by following
-//! that value, never by a change of parity (which a pair of crossings inside one step hides).
+//! boundary is where one characteristic value crosses a. Each value belongs to one of four
+//! families (a_even, b_even, a_odd, b_odd), each the spectrum of its own block of T
+//! ([`family`]); [`follow`] finds where one value meets a by Newton steps in q on its block's
+//! determinant, kept honest by the block's Sturm counts and by bounds on the value's slope and
+//! curvature, and [`windows`] picks the values that end a window, never going by a change of
+//! parity (which a pair of crossings inside one step hides).
 //!
 //! Truncation: N harmonics on each side with (2N)² far above |a| + 2|q|; the coefficients then
 //! fall faster than geometrically (ratio ≈ q/(2r)²), and truncation only raises eigenvalues
@@ -45,6 +49,8 @@
 //! tr M_u needed.
 
 pub mod damped;
+pub mod family;
+pub mod follow;
 pub mod windows;
 
 pub use damped::{

@@ -86,7 +86,7 @@ pub struct DampedWindow {
 
 /// The first window in m at (k, δ > 0): it contains the undamped window at k' = k − δ²/4, and
 /// each end is found by walking outward from that window's end in growing steps to the first
-/// unstable m, then bisecting.
+/// unstable m, then closing in on |tr M_u| = 2 cosh(πδ) by regula falsi (Illinois).
 pub fn damped_window(
     k: f64,
     delta: f64,
@@ -99,14 +99,15 @@ pub fn damped_window(
     let (inner, _, counts) = first_window(kp, M_MAX, tol)?;
     let mut traces = 0u64;
     let mut counts = counts;
+    let h = math::PI / f64::from(half_steps.max(1));
+    // |tr M_u| − 2 cosh(πδ): negative exactly where the damped problem is stable.
+    let mut excess = |m: f64| {
+        traces += 1;
+        trace_u_with(kp, m, half_steps, |j| math::cos(0.5 * h * f64::from(j))).abs() - bound
+    };
     let mut stable = |m: f64| {
         counts += 1;
-        if stability_count(4.0 * kp, 2.0 * m) % 2 == 1 {
-            return true;
-        }
-        traces += 1;
-        let h = math::PI / f64::from(half_steps.max(1));
-        trace_u_with(kp, m, half_steps, |j| math::cos(0.5 * h * f64::from(j))).abs() < bound
+        stability_count(4.0 * kp, 2.0 * m) % 2 == 1 || excess(m) < 0.0
     };
     let (l0, u0) = match (inner.lower, inner.upper) {
         (End::Value(l), u) => (l, u.value()),
@@ -123,15 +124,16 @@ pub fn damped_window(
             });
         }
     };
-    let lower = if l0 == 0.0 {
-        0.0
+    let lower_bracket = if l0 == 0.0 {
+        None
     } else {
-        outward(&mut stable, l0, -1.0, 0.0, tol).unwrap_or(0.0)
+        outward(&mut stable, l0, -1.0, 0.0)
     };
-    let upper = match u0 {
-        Some(u) => outward(&mut stable, u, 1.0, M_MAX, tol)
-            .map_or(End::Missing(STABLE_TO_LIMIT), End::Value),
-        None => End::Missing(STABLE_TO_LIMIT),
+    let upper_bracket = u0.and_then(|u| outward(&mut stable, u, 1.0, M_MAX));
+    let lower = lower_bracket.map_or(0.0, |b| illinois(&mut excess, b, tol));
+    let upper = match (u0, upper_bracket) {
+        (Some(_), Some(b)) => End::Value(illinois(&mut excess, b, tol)),
+        _ => End::Missing(STABLE_TO_LIMIT),
     };
     Ok(DampedWindow {
         window: Window {
@@ -145,17 +147,17 @@ pub fn damped_window(
 }
 
 /// From a stable `start`, steps in direction `dir` (growing by half each step) to the first
-/// unstable m before `limit`, then bisects to `tol`; `None` if stable all the way.
+/// unstable m before `limit`: the bracket (last stable, first unstable); `None` if stable all
+/// the way.
 fn outward(
     stable: &mut impl FnMut(f64) -> bool,
     start: f64,
     dir: f64,
     limit: f64,
-    tol: f64,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let mut inside = start;
     let mut h = 1e-4;
-    let outside = loop {
+    loop {
         let m = inside + dir * h;
         let m = if dir > 0.0 {
             m.min(limit)
@@ -163,25 +165,56 @@ fn outward(
             m.max(limit)
         };
         if !stable(m) {
-            break m;
+            return Some((inside, m));
         }
         if m == limit {
             return None;
         }
         inside = m;
         h *= 1.5;
-    };
+    }
+}
+
+/// The zero of `excess` between a stable `inside` (excess < 0) and an unstable `outside`
+/// (excess ≥ 0), to within `tol`: regula falsi with the Illinois modification (the value at a
+/// side kept twice is halved, so both sides close in; Dowell & Jarratt, BIT 11, 1971).
+fn illinois(excess: &mut impl FnMut(f64) -> f64, (inside, outside): (f64, f64), tol: f64) -> f64 {
     let (mut a, mut b) = (inside, outside);
-    while (b - a).abs() > tol {
-        let mid = a + 0.5 * (b - a);
-        if mid == a || mid == b {
+    let (mut fa, mut fb) = (excess(a), excess(b));
+    if !(fa < 0.0 && fb >= 0.0) {
+        // The trace disagrees with the verdict that made the bracket (only at rounding level):
+        // the bracket's midpoint is as good as any point in it.
+        return a + 0.5 * (b - a);
+    }
+    let mut kept = 0i8;
+    for _ in 0..200 {
+        if (b - a).abs() <= tol {
             break;
         }
-        if stable(mid) {
-            a = mid;
+        let mut c = (a * fb - b * fa) / (fb - fa);
+        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+        if !(c > lo && c < hi) {
+            c = a + 0.5 * (b - a);
+            if !(c > lo && c < hi) {
+                break;
+            }
+        }
+        let fc = excess(c);
+        if fc < 0.0 {
+            a = c;
+            fa = fc;
+            if kept == -1 {
+                fb *= 0.5;
+            }
+            kept = -1;
         } else {
-            b = mid;
+            b = c;
+            fb = fc;
+            if kept == 1 {
+                fa *= 0.5;
+            }
+            kept = 1;
         }
     }
-    Some(a + 0.5 * (b - a))
+    a + 0.5 * (b - a)
 }

@@ -11,13 +11,16 @@
 //! value being approached, and a tongue narrower than 5e-7 in m where a characteristic value
 //! stays within 2e-6 of a (steps never go below 1e-6 in q; that happens only at tongue tips).
 //!
-//! Below the first tongue (k < 1/4, which includes the inverted position) the first window is
-//! (a₀, b₁), and a₀(q), b₁(q) decrease monotonically (McLachlan §2.2; checked against the walk
-//! in the tests), so [`first_window`] bisects the counts "C ≥ 1" and "C ≥ 2" directly: about
-//! 90 Sturm counts per window.
+//! [`first_window`] does not walk all values: the first window lies between two known ones
+//! (a₀ and b₁ below the first tongue, k < 1/4; aⱼ and bⱼ₊₁ above it), and each end is where one
+//! of them meets a, found by [`super::follow`] in its own family's block: 2–40 passes over a
+//! block of ≈ 15 rows per end instead of hundreds of full counts.
 
-use super::{count_below, harmonics, stability_count};
+use super::family::{rows_for, Family, Value};
+use super::follow::Follower;
+use super::{count_below, follow, harmonics, stability_count};
 use crate::error::ParamError;
+use crate::math;
 use crate::stability::{check_k, check_order, check_tol, End, Window, M_MAX};
 
 /// Reason: no end up to the largest m searched.
@@ -215,28 +218,23 @@ impl Iterator for Windows {
 }
 
 /// The undamped first window in m at k (the one starting at m = 0 for k ≥ 0), searched up to
-/// `m_max`, with whether its upper end is a flutter (tr M = −2) boundary.
+/// `m_max`, with whether its upper end is a flutter (tr M = −2) boundary and the LDLᵀ passes
+/// it took.
 pub fn first_window(k: f64, m_max: f64, tol: f64) -> Result<(Window, bool, u64), ParamError> {
     let k = check_k(k)?;
+    let tol = check_tol(tol)?;
+    if !(m_max.is_finite() && m_max > 0.0) {
+        return Err(ParamError {
+            name: "m_max",
+            value: m_max,
+            allowed: "a positive number",
+        });
+    }
+    let q_end = 2.0 * m_max.min(M_MAX);
     if k < 0.25 {
-        return below_first_tongue(k, m_max, tol);
+        return Ok(below_first_tongue(4.0 * k, q_end, 2.0 * tol));
     }
-    let mut w = Windows::new(k, m_max, tol)?;
-    // At k ≥ 0 the hanging position is stable without drive (k = 0: marginal, and stable for
-    // any small m since a₀(q) < 0): the window starts at m = 0.
-    let l = 0.0;
-    for t in w.by_ref() {
-        if t.stable_before() && !t.stable_after() {
-            let win = window(End::Value(l), End::Value(t.m));
-            return Ok((win, t.flutter, w.counts));
-        }
-    }
-    let counts = w.counts;
-    Ok((
-        window(End::Value(l), End::Missing(STABLE_TO_LIMIT)),
-        false,
-        counts,
-    ))
+    Ok(between_tongues(4.0 * k, q_end, 2.0 * tol))
 }
 
 fn window(lower: End, upper: End) -> Window {
@@ -247,44 +245,128 @@ fn window(lower: End, upper: End) -> Window {
     }
 }
 
-/// k < 1/4 (a < 1): the window (a₀, b₁) by bisecting the monotone counts C ≥ 1 (for k < 0;
-/// for k ≥ 0, a₀(q) ≤ 0 ≤ a and the window starts at m = 0) and C ≥ 2.
-fn below_first_tongue(k: f64, m_max: f64, tol: f64) -> Result<(Window, bool, u64), ParamError> {
-    let tol = check_tol(tol)?;
-    let a = 4.0 * k;
-    let q_end = 2.0 * m_max.min(M_MAX);
-    let mut counts = 0u64;
-    let mut first_at_least = |want: u32| -> Option<f64> {
-        counts += 1;
-        if stability_count(a, q_end) < want {
-            return None;
-        }
-        let (mut lo, mut hi) = (0.0, q_end);
-        while hi - lo > 2.0 * tol {
-            let mid = lo + 0.5 * (hi - lo);
-            if mid <= lo || mid >= hi {
-                break;
-            }
-            counts += 1;
-            if stability_count(a, mid) >= want {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        Some(0.25 * (lo + hi))
+/// a < 1 (k < 1/4): the window (a₀, b₁). Both decrease in q (McLachlan §2.2; checked against
+/// the walk in the tests), so each end is the one change of its family's count on [0, q_end]:
+/// Newton in q from the large-q asymptote a₀ ≈ b₁ ≈ −2q + 2√q − 1/4 (A&S 20.2.30), or from the
+/// small-q series a₀ ≈ −q²/2, b₁ ≈ 1 − q − q²/8 (A&S 20.2.25) where that is nearer.
+fn below_first_tongue(a: f64, q_end: f64, tol_q: f64) -> (Window, bool, u64) {
+    let mut passes = 0u64;
+    let crosses = |fam: Family, passes: &mut u64| {
+        *passes += 1;
+        fam.count(q_end, a, rows_for(a, q_end)) > 0
     };
-    let lower = if k >= 0.0 {
+    // −2q + 2√q − 1/4 = a  ⇔  √q = (1 + √(1/2 − 2a))/2.
+    let asymptote = {
+        let s = 0.5 * (1.0 + math::sqrt((0.5 - 2.0 * a).max(0.0)));
+        s * s
+    };
+    let lower = if a >= 0.0 {
         Some(0.0)
+    } else if crosses(Family::EvenCos, &mut passes) {
+        let series = math::sqrt(-2.0 * a);
+        let guess = if series < 1.0 { series } else { asymptote };
+        Some(follow::root_in(
+            Family::EvenCos,
+            a,
+            (0.0, q_end),
+            0,
+            guess,
+            tol_q,
+            &mut passes,
+        ))
     } else {
-        first_at_least(1)
+        None
     };
-    let w = match (lower, first_at_least(2)) {
-        (None, _) => window(End::Missing(NEVER_STABLE), End::Missing(NEVER_STABLE)),
-        (Some(l), None) => window(End::Value(l), End::Missing(STABLE_TO_LIMIT)),
-        (Some(l), Some(u)) => window(End::Value(l), End::Value(u)),
+    let Some(lower) = lower else {
+        let none = window(End::Missing(NEVER_STABLE), End::Missing(NEVER_STABLE));
+        return (none, false, passes);
     };
-    Ok((w, w.upper.value().is_some(), counts))
+    if !crosses(Family::OddSin, &mut passes) {
+        return (
+            window(End::Value(0.5 * lower), End::Missing(STABLE_TO_LIMIT)),
+            false,
+            passes,
+        );
+    }
+    // b₁ > a₀, so b₁ meets a above a₀'s crossing (a bracket end, unless the window is
+    // narrower than the tolerance).
+    passes += 1;
+    let lo = if Family::OddSin.count(lower, a, rows_for(a, lower)) == 0 {
+        lower
+    } else {
+        0.0
+    };
+    // q²/8 + q = 1 − a on the series.
+    let series = 4.0 * (math::sqrt(1.0 + 0.5 * (1.0 - a)) - 1.0);
+    let guess = if a > -1.0 { series } else { asymptote.max(lo) };
+    let upper = follow::root_in(Family::OddSin, a, (lo, q_end), 0, guess, tol_q, &mut passes);
+    (
+        window(End::Value(0.5 * lower), End::Value(0.5 * upper)),
+        true,
+        passes,
+    )
+}
+
+/// a ≥ 1 (k ≥ 1/4): the window starts at m = 0 between aⱼ and bⱼ₊₁ (j = ⌊√a⌋; the values
+/// interlace a₀ < b₁ < a₁ < b₂ < … for q > 0, so no other value can reach a first) and ends
+/// where aⱼ rising or bⱼ₊₁ falling first meets a, each followed from q = 0.
+///
+/// At a tongue tip a = j²: for j = 1, 2 the pair splits across a at once (b₁ = 1 − q,
+/// a₁ = 1 + q; b₂ = 4 − q²/12, a₂ = 4 + 5q²/12), so the window has zero width; for j ≥ 3 both
+/// rise (aⱼ, bⱼ = j² + q²/(2(j² − 1)) + O(q³); A&S 20.2.25), so the window lies between aⱼ₋₁ and
+/// bⱼ, and bⱼ is followed from q = 0.1, where the series' q² term outweighs the rest by ≥ 40
+/// (b₃ = 9 + q²/16 − q³/64 + …, b₄ = 16 + q²/30 − 317q⁴/864000 + …).
+fn between_tongues(a: f64, q_end: f64, tol_q: f64) -> (Window, bool, u64) {
+    let mut j = math::sqrt(a) as u32;
+    while f64::from(j + 1) * f64::from(j + 1) <= a {
+        j += 1;
+    }
+    while f64::from(j) * f64::from(j) > a {
+        j -= 1;
+    }
+    let tip = f64::from(j * j) == a;
+    if tip && j <= 2 {
+        return (window(End::Value(0.0), End::Value(0.0)), j == 1, 0);
+    }
+    let (below, above, q_above) = if tip {
+        (Value::a(j - 1), Value::b(j), 0.1)
+    } else {
+        (Value::a(j), Value::b(j + 1), 0.0)
+    };
+    // Both walks advance together, the one behind first, so that neither goes past the
+    // other's crossing.
+    let mut rising = Follower::new(below, a, 0.0, tol_q);
+    let mut falling = Follower::new(above, a, q_above, tol_q);
+    for _ in 0..200_000 {
+        let limit = [rising.crossing, falling.crossing]
+            .into_iter()
+            .flatten()
+            .fold(q_end, f64::min);
+        let (behind, ahead) = if rising.q <= falling.q {
+            (&mut rising, &mut falling)
+        } else {
+            (&mut falling, &mut rising)
+        };
+        let moved = behind.step(limit) || ahead.step(limit);
+        if !moved {
+            break;
+        }
+    }
+    let passes = rising.passes + falling.passes;
+    let (end, by) = match (rising.crossing, falling.crossing) {
+        (Some(r), Some(f)) if f < r => (f, above),
+        (Some(r), _) => (r, below),
+        (None, Some(f)) => (f, above),
+        (None, None) => {
+            let w = window(End::Value(0.0), End::Missing(STABLE_TO_LIMIT));
+            return (w, false, passes);
+        }
+    };
+    (
+        window(End::Value(0.0), End::Value(0.5 * end)),
+        by.is_odd(),
+        passes,
+    )
 }
 
 /// The undamped order-n subharmonic threshold in the first window: the m where the
