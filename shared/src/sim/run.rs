@@ -8,13 +8,13 @@
 //! its own loop ([`super::friction`]).
 
 use super::adaptive::{self, Fast, Slow};
-use super::classify::{self, Outcome, Undecided};
+use super::classify::{self, Outcome, Strobes, Undecided};
 use super::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use super::fidelity::{self, Decision, FidelityError};
 use super::friction;
 use super::lyapunov;
 use super::periodic;
-use super::sampling::{Hermite, Interpolant, Recorder, Sampler};
+use super::sampling::{Hermite, Interpolant, Recorder, Sampler, Sink};
 use super::scene::{Fidelity, Physical, Scene, SceneError};
 use super::sensor::Encoder;
 use super::signal::{DriveSignal, Schedule, Shaped, Steady};
@@ -219,15 +219,14 @@ pub(super) struct Context {
 
 impl Context {
     /// The run's sampler, started at t = 0 from the initial state.
-    pub(super) fn sampler<'r, Rec: Recorder>(&self, rec: &'r mut Rec) -> Sampler<'r, Rec> {
+    pub(super) fn sampler<'r, Rec: Recorder>(&self, sink: Sink<'r, Rec>) -> Sampler<'r, Rec> {
         let mut sampler = Sampler::new(
             self.schedule,
             self.strobes_total,
             self.out_dt,
             self.sensor.clone(),
             self.t_end,
-            self.classify,
-            rec,
+            sink,
         );
         sampler.start(self.y0.0, self.y0.1);
         sampler
@@ -448,6 +447,11 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
     ctx: &Context,
     rec: &mut Rec,
 ) -> Result<Report, SimError> {
+    let mut window = None;
+    let rec = Sink {
+        rec,
+        window: ctx.classify.then(|| window.insert(Strobes::default())),
+    };
     let full =
         || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, scene.drive.angle, sig, NoExtra);
     let averaged = || {
@@ -500,7 +504,12 @@ fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
             sticks,
         });
     }
-    let outcome = classify::classify(&sampler.strobes, p.omega, ctx.undamped, || {
+    let Some(strobes) = sampler.strobes.as_deref() else {
+        return Err(SimError::Unsupported(
+            "a classifying run keeps its window of strobes",
+        ));
+    };
+    let outcome = classify::classify(strobes, p.omega, ctx.undamped, || {
         match (sampler.window_start, scene.effects.coulomb) {
             (Some(start), None) => {
                 let (lambda, w) =
@@ -570,7 +579,7 @@ pub(super) fn with_equation<R: Real, D: DriveSignal<R>, J: Job<R>>(
 /// The main run as a [`Job`].
 struct Integrate<'c, 'r, Rec: Recorder> {
     ctx: &'c Context,
-    rec: &'r mut Rec,
+    rec: Sink<'r, Rec>,
 }
 
 impl<'c, 'r, R: Real, Rec: Recorder> Job<R> for Integrate<'c, 'r, Rec> {
@@ -609,7 +618,7 @@ fn pair<R: Real>(y: &[R; 2]) -> (f64, f64) {
 pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     sys: S,
     ctx: &Context,
-    rec: &'r mut Rec,
+    rec: Sink<'r, Rec>,
 ) -> Result<RunOut<'r, Rec>, SimError> {
     let mut sampler = ctx.sampler(rec);
     let mut turns = Turns::new(ctx.periodic);
