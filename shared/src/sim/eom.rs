@@ -17,6 +17,7 @@
 //! drive × none, viscous or sliding friction); everything rarer shares [`super::signal::Shaped`].
 
 use super::signal::DriveSignal;
+use super::slow_series::SlowSeries;
 use crate::integrate::System;
 use crate::model::DriveAngle;
 use crate::Real;
@@ -156,6 +157,16 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
 impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
     pub fn drive(&self) -> &D {
         &self.drive
+    }
+
+    /// The force about φ0 (given sin φ0, cos φ0) as a power series, for a step over which the
+    /// drive's strength stays at its value at t.
+    #[inline(always)]
+    pub(super) fn series(&self, t: f64, s: R, c: R) -> SlowSeries<R> {
+        let s_rel = s * self.cos_d - c * self.sin_d;
+        let c_rel = c * self.cos_d + s * self.sin_d;
+        let h_sigma = self.half_r * self.drive.strength(t);
+        SlowSeries::about(self.omega0_sq, h_sigma, (s, c), (s_rel, c_rel))
     }
 
     /// Gravity and the averaged drive force at t, given (sin φ, cos φ).

@@ -23,7 +23,7 @@
 
 use super::eom::{FullEom, NoExtra, Sliding};
 use super::run::{Context, Dense, EndState, Method, RunOut, SimError};
-use super::sampling::{Interpolant, Recorder, Sampler};
+use super::sampling::{Interpolant, Recorder, Sampler, Sink};
 use super::signal::DriveSignal;
 use super::turns::{Shifted, Turns};
 use crate::integrate::{Dop853, Stats, Step, StepControl};
@@ -48,7 +48,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     c: R,
     mu: f64,
     ctx: &Context,
-    rec: &'r mut Rec,
+    rec: Sink<'r, Rec>,
 ) -> Result<RunOut<'r, Rec>, SimError> {
     let Method::Dop853 { rtol, atol } = ctx.method else {
         return Err(SimError::Unsupported(

@@ -13,6 +13,7 @@
 //! | [`noise`] | seeded, reproducible uniform and Gaussian noise |
 //! | [`friction`] | Coulomb stick–slip as switched smooth segments |
 //! | `periodic` | the full equation by RKN 8(6), a whole number of steps per drive period |
+//! | `slow_series` | the averaged force as a power series about a step's start: no sin/cos per stage |
 //! | `adaptive` | the full or averaged equation by an adaptive RKN pair (8(6), 12(10)), no libm sin/cos of the angle per evaluation |
 //! | [`lyapunov`] | the finite-time Lyapunov exponent of the analysis window |
 //! | `turns` | whole turns kept out of the integrated angle, so rotation never loses precision |
@@ -69,6 +70,7 @@ pub mod sampling;
 pub mod scene;
 pub mod sensor;
 pub mod signal;
+mod slow_series;
 mod turns;
 pub mod wobble;
 

@@ -18,7 +18,7 @@
 
 use super::eom::{FullEom, NoExtra};
 use super::run::{Context, EndState, RunOut, SimError};
-use super::sampling::{Hermite, Interpolant, Recorder};
+use super::sampling::{Hermite, Interpolant, Recorder, Sink};
 use super::signal::DriveSignal;
 use super::turns::{Shifted, Turns};
 use crate::integrate::rkn::tableau::STAGES;
@@ -87,7 +87,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     c: f64,
     (rtol, atol): (f64, f64),
     ctx: &Context,
-    rec: &'r mut Rec,
+    rec: Sink<'r, Rec>,
 ) -> Result<RunOut<'r, Rec>, SimError> {
     let mut sampler = ctx.sampler(rec);
     let period = ctx.period;

@@ -48,6 +48,14 @@ impl Recorder for Discard {
     }
 }
 
+/// Where a run's samples go: the recorder, and the classifier's window of strobes when the run
+/// classifies. The window (1024 strobes) is borrowed from the caller, so a run that does not
+/// classify allocates none and its sampler stays small enough to move for free.
+pub struct Sink<'a, Rec> {
+    pub rec: &'a mut Rec,
+    pub window: Option<&'a mut Strobes>,
+}
+
 /// The schedules of one run.
 pub struct Sampler<'a, Rec: Recorder> {
     schedule: Schedule,
@@ -69,7 +77,8 @@ pub struct Sampler<'a, Rec: Recorder> {
     next_progress: f64,
     /// The earliest of all the schedules: a step ending before it has nothing to do.
     next_event: f64,
-    pub strobes: Strobes,
+    /// The classifier's window (when the run classifies).
+    pub strobes: Option<&'a mut Strobes>,
     /// (k, t, θ, θ') at the strobe that opens the analysis window: where a Lyapunov run starts.
     pub window_start: Option<(u64, f64, f64, f64)>,
     pub rec: &'a mut Rec,
@@ -77,17 +86,18 @@ pub struct Sampler<'a, Rec: Recorder> {
 
 impl<'a, Rec: Recorder> Sampler<'a, Rec> {
     /// `strobes_total`: the number of strobes the run will see; `out_dt`: output interval (0 for
-    /// none); `classify`: keep the analysis window (strobes with period means) for the classifier.
-    /// A run that neither classifies nor records strobes computes none.
+    /// none); a window in `sink`: keep the analysis window (strobes with period means) there for
+    /// the classifier. A run that neither classifies nor records strobes computes none.
     pub fn new(
         schedule: Schedule,
         strobes_total: u64,
         out_dt: f64,
         sensor: Option<Encoder>,
         t_end: f64,
-        classify: bool,
-        rec: &'a mut Rec,
+        sink: Sink<'a, Rec>,
     ) -> Self {
+        let Sink { rec, window } = sink;
+        let classify = window.is_some();
         let window_from = if classify {
             strobes_total.saturating_sub(WINDOW as u64 - 1).max(1)
         } else {
@@ -114,7 +124,7 @@ impl<'a, Rec: Recorder> Sampler<'a, Rec> {
             t_end,
             next_progress: 0.0,
             next_event: 0.0,
-            strobes: Strobes::default(),
+            strobes: window,
             window_start: None,
             rec,
         };
@@ -211,8 +221,8 @@ impl<'a, Rec: Recorder> Sampler<'a, Rec> {
                 } else {
                     f64::NAN
                 };
-                if in_window {
-                    self.strobes.push(Strobe {
+                if let (true, Some(window)) = (in_window, self.strobes.as_deref_mut()) {
+                    window.push(Strobe {
                         theta: th,
                         rate: v,
                         mean,

@@ -30,8 +30,9 @@ pub trait Accel<R: Real> {
     /// Whether g is independent of t (then the stage times are never computed).
     fn autonomous(&self) -> bool;
     fn base(&self, t0: f64, theta0: R) -> Self::Base;
-    /// g at (t, θ), inside the step whose start gave `base`.
-    fn accel(&self, base: &Self::Base, t: f64, theta: R) -> R;
+    /// g at (t, θ), inside the step whose start gave `base`; `offset` = θ − θ0 (formed without
+    /// the rounding of that difference).
+    fn accel(&self, base: &Self::Base, t: f64, theta: R, offset: R) -> R;
 }
 
 /// The settings of an adaptive RKN 8(6) run.
@@ -155,7 +156,7 @@ impl AdaptiveRkn {
         if t1.is_nan() || t1 <= t0 || !y.0.is_finite() || !y.1.is_finite() {
             return Ok(Solution { t, y, stats });
         }
-        let mut g0 = sys.accel(&sys.base(t, y.0), t, y.0);
+        let mut g0 = sys.accel(&sys.base(t, y.0), t, y.0, R::ZERO);
         stats.rhs_evals += 1;
         let h_max = self.h_max.min(t1 - t0);
         let mut h = self
@@ -180,7 +181,9 @@ impl AdaptiveRkn {
             h = t_new - t;
             let m = Damped::of(pair, h, c, !sys.autonomous());
             let base = sys.base(t, y.0);
-            let out = m.step(y.0, y.1, g0, |i, th| sys.accel(&base, t + m.tau[i], th));
+            let out = m.step_from(y.0, y.1, g0, |i, th, d| {
+                sys.accel(&base, t + m.tau[i], th, d)
+            });
             stats.rhs_evals += S as u64 - 1;
             let err = scaled(out.error.0, y.0, out.theta).max(scaled(out.error.1, y.1, out.rate));
             if !err.is_finite() || !out.theta.is_finite() || !out.rate.is_finite() {
@@ -198,7 +201,7 @@ impl AdaptiveRkn {
                 out.g1
             } else {
                 stats.rhs_evals += 1;
-                sys.accel(&sys.base(t_new, out.theta), t_new, out.theta)
+                sys.accel(&sys.base(t_new, out.theta), t_new, out.theta, R::ZERO)
             };
             let span = Span {
                 t0: t,
@@ -255,7 +258,7 @@ mod tests {
             true
         }
         fn base(&self, _t0: f64, _theta0: f64) {}
-        fn accel(&self, _: &(), _t: f64, theta: f64) -> f64 {
+        fn accel(&self, _: &(), _t: f64, theta: f64, _: f64) -> f64 {
             -self.0 * theta
         }
     }
@@ -324,7 +327,7 @@ mod tests {
                 true
             }
             fn base(&self, _: f64, _: f64) {}
-            fn accel(&self, _: &(), _: f64, th: f64) -> f64 {
+            fn accel(&self, _: &(), _: f64, th: f64, _: f64) -> f64 {
                 -100.0 * th.sin()
             }
         }

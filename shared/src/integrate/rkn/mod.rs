@@ -117,6 +117,7 @@ impl<const S: usize> Damped<S> {
     /// Steps of `pair` of size `h` with damping `c` ≥ 0. Without `times` the stage times (one
     /// log1p each) are left out and [`Damped::tau`] is NaN: what an adaptive run of an
     /// autonomous equation, building a new step size every step, wants.
+    #[inline]
     pub fn of(pair: &'static Pair<S>, h: f64, c: f64, times: bool) -> Self {
         let ch = c * h;
         // S = (1 − e^(−cH))/c; τ(s) = −ln(1 − c s)/c; e^(−cH) = 1 − c S.
@@ -124,16 +125,19 @@ impl<const S: usize> Damped<S> {
         let s = if c > 0.0 { -expm1 / c } else { h };
         let mut tau = [f64::NAN; S];
         let mut weight = [1.0; S];
-        for i in 0..S {
-            let x = c * pair.c[i] * s;
-            if c > 0.0 {
-                weight[i] = 1.0 / ((1.0 - x) * (1.0 - x));
+        if c > 0.0 {
+            // Branch-free, so that the divisions pair up in vector registers.
+            for (w, &ci) in weight.iter_mut().zip(&pair.c) {
+                let e = 1.0 - c * ci * s;
+                *w = 1.0 / (e * e);
             }
-            if times {
-                tau[i] = if c > 0.0 {
-                    -libm::log1p(-x) / c
+        }
+        if times {
+            for (t, &ci) in tau.iter_mut().zip(&pair.c) {
+                *t = if c > 0.0 {
+                    -libm::log1p(-(c * ci * s)) / c
                 } else {
-                    pair.c[i] * h
+                    ci * h
                 };
             }
         }
@@ -157,43 +161,68 @@ impl<const S: usize> Damped<S> {
         g0: R,
         mut g: impl FnMut(usize, R) -> R,
     ) -> RknStep<R> {
+        self.step_from(theta, rate, g0, |i, th, _| g(i, th))
+    }
+
+    /// [`Damped::step`] with g also handed each stage's offset δ = θ_i − θ from the step's
+    /// start, computed without the rounding of θ_i − θ: `g(i, θ_i, δ_i)`.
+    ///
+    /// Every stage waits for the previous one's g, so the arithmetic between two evaluations is
+    /// the step's latency: the stage offset is formed as
+    /// δ_i = (c_i S θ' + S² Σ_{j<i−1} a_ij w_j g_j) + (S² a_{i,i−1} w_{i−1}) g_{i−1}, whose first
+    /// part and whose factor are ready before g_{i−1} is, so only one multiply and one add stand
+    /// between g_{i−1} and stage i (w_j: the damping weights).
+    #[inline(always)]
+    pub fn step_from<R: Real>(
+        &self,
+        theta: R,
+        rate: R,
+        g0: R,
+        mut g: impl FnMut(usize, R, R) -> R,
+    ) -> RknStep<R> {
         let p = self.pair;
         let s = R::from_f64(self.s);
         let s2 = R::from_f64(self.s * self.s);
-        // k[i]: the transformed acceleration at stage i.
+        // k[i] = w_i g_i: the transformed acceleration at stage i; raw: g_{i−1}.
         let mut k = [R::ZERO; S];
-        k[0] = g0;
-        let mut raw_last = g0;
+        k[0] = R::from_f64(self.weight[0]) * g0;
+        let mut raw = g0;
         for i in 1..S {
-            let mut acc = R::ZERO;
-            for (&a, &kj) in p.a[i].iter().zip(&k).take(i) {
-                if a != 0.0 {
-                    acc += R::from_f64(a) * kj;
-                }
-            }
-            let y = theta + R::from_f64(p.c[i]) * s * rate + s2 * acc;
-            raw_last = g(i, y);
-            k[i] = R::from_f64(self.weight[i]) * raw_last;
+            let acc = dot(&p.a[i][..i - 1], &k[..i - 1]);
+            let ready = R::from_f64(p.c[i]) * s * rate + s2 * acc;
+            let last = R::from_f64(self.s * self.s * p.a[i][i - 1] * self.weight[i - 1]);
+            let d = ready + last * raw;
+            raw = g(i, theta + d, d);
+            k[i] = R::from_f64(self.weight[i]) * raw;
         }
-        let (mut ph, mut vh, mut pl, mut vl) = (R::ZERO, R::ZERO, R::ZERO, R::ZERO);
-        for (i, &ki) in k.iter().enumerate() {
-            ph += R::from_f64(p.bbar[i]) * ki;
-            vh += R::from_f64(p.b[i]) * ki;
-            pl += R::from_f64(p.bbar_low[i]) * ki;
-            vl += R::from_f64(p.b_low[i]) * ki;
-        }
+        let (ph, vh) = (dot(&p.bbar, &k), dot(&p.b, &k));
+        let (pl, vl) = (dot(&p.bbar_low, &k), dot(&p.b_low, &k));
         let decay = R::from_f64(self.decay);
         RknStep {
             theta: theta + s * rate + s2 * ph,
             rate: decay * (rate + s * vh),
-            g1: if p.fsal {
-                raw_last
-            } else {
-                R::from_f64(f64::NAN)
-            },
+            g1: if p.fsal { raw } else { R::from_f64(f64::NAN) },
             error: (s2 * (ph - pl), decay * s * (vh - vl)),
         }
     }
+}
+
+/// Σ a_j k_j in four interleaved partial sums: one running sum would chain every addition.
+#[inline(always)]
+fn dot<R: Real>(a: &[f64], k: &[R]) -> R {
+    let (mut s0, mut s1, mut s2, mut s3) = (R::ZERO, R::ZERO, R::ZERO, R::ZERO);
+    let (a4, k4) = (a.chunks_exact(4), k.chunks_exact(4));
+    let (ar, kr) = (a4.remainder(), k4.remainder());
+    for (a, k) in a4.zip(k4) {
+        s0 += R::from_f64(a[0]) * k[0];
+        s1 += R::from_f64(a[1]) * k[1];
+        s2 += R::from_f64(a[2]) * k[2];
+        s3 += R::from_f64(a[3]) * k[3];
+    }
+    for (&a, &k) in ar.iter().zip(kr) {
+        s0 += R::from_f64(a) * k;
+    }
+    (s0 + s1) + (s2 + s3)
 }
 
 #[cfg(test)]

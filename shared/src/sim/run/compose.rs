@@ -15,13 +15,13 @@ use crate::integrate::rkn::{RKN1210, RKN86};
 use crate::integrate::{Stats, System};
 use crate::real::Real;
 use crate::sim::adaptive::{self, Fast, Slow};
-use crate::sim::classify::{self, Outcome, Undecided};
+use crate::sim::classify::{self, Outcome, Strobes, Undecided};
 use crate::sim::eom::{AveragedEom, FullEom, LinearisedEom, NoExtra, Viscous};
 use crate::sim::fidelity;
 use crate::sim::friction;
 use crate::sim::lyapunov;
 use crate::sim::periodic;
-use crate::sim::sampling::{Recorder, Sampler};
+use crate::sim::sampling::{Recorder, Sampler, Sink};
 use crate::sim::scene::Fidelity;
 use crate::sim::signal::DriveSignal;
 
@@ -43,6 +43,11 @@ pub(super) fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
 ) -> Result<Report, SimError> {
     let (p, ctx, angle) = (&plan.physical, &plan.ctx, plan.scene.drive.angle);
     let coulomb = plan.scene.effects.coulomb;
+    let mut window = None;
+    let rec = Sink {
+        rec,
+        window: ctx.classify.then(|| window.insert(Strobes::default())),
+    };
     let full = || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, angle, sig, NoExtra);
     let averaged =
         || AveragedEom::<R, D, _>::new(p.omega0 * p.omega0, plan.r_effective, angle, sig, NoExtra);
@@ -77,7 +82,12 @@ pub(super) fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
     } = out;
     let mut lyapunov_work = Stats::default();
     let outcome = if ctx.classify {
-        classify::classify(&sampler.strobes, p.omega, ctx.undamped, || {
+        let Some(strobes) = sampler.strobes.as_deref() else {
+            return Err(SimError::Unsupported(
+                "a classifying run keeps its window of strobes",
+            ));
+        };
+        classify::classify(strobes, p.omega, ctx.undamped, || {
             match (sampler.window_start, coulomb) {
                 (Some(start), None) => {
                     let (lambda, w) = with_equation(plan, sig, lyapunov::Exponent { ctx, start });
@@ -150,7 +160,7 @@ fn with_equation<R: Real, D: DriveSignal<R>, J: Job<R>>(
 /// The main run as a [`Job`].
 struct Integrate<'c, 'r, Rec: Recorder> {
     plan: &'c PlannedRun,
-    rec: &'r mut Rec,
+    rec: Sink<'r, Rec>,
 }
 
 impl<'c, 'r, R: Real, Rec: Recorder> Job<R> for Integrate<'c, 'r, Rec> {

@@ -8,7 +8,7 @@ use super::{EndState, Format, Method, Options, Report, SimError};
 use crate::math;
 use crate::real::Real;
 use crate::sim::fidelity::{self, Decision};
-use crate::sim::sampling::{Recorder, Sampler};
+use crate::sim::sampling::{Recorder, Sampler, Sink};
 use crate::sim::scene::{Fidelity, Physical, Scene};
 use crate::sim::sensor::Encoder;
 use crate::sim::signal::{Schedule, Shaped, Steady};
@@ -41,15 +41,14 @@ pub(in crate::sim) struct Context {
 
 impl Context {
     /// The run's sampler, started at t = 0 from the initial state.
-    pub(in crate::sim) fn sampler<'r, Rec: Recorder>(&self, rec: &'r mut Rec) -> Sampler<'r, Rec> {
+    pub(in crate::sim) fn sampler<'r, Rec: Recorder>(&self, sink: Sink<'r, Rec>) -> Sampler<'r, Rec> {
         let mut sampler = Sampler::new(
             self.schedule,
             self.strobes_total,
             self.out_dt,
             self.sensor.clone(),
             self.t_end,
-            self.classify,
-            rec,
+            sink,
         );
         sampler.start(self.y0.0, self.y0.1);
         sampler

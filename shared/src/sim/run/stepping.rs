@@ -9,7 +9,7 @@ use crate::integrate::{
     StepControl, Symplectic, System,
 };
 use crate::real::Real;
-use crate::sim::sampling::{Hermite, Interpolant, Recorder, Sampler};
+use crate::sim::sampling::{Hermite, Interpolant, Recorder, Sampler, Sink};
 use crate::sim::turns::{Shifted, Turns};
 
 /// Dense output of an accepted DOP853 step as an [`Interpolant`].
@@ -34,7 +34,7 @@ fn pair<R: Real>(y: &[R; 2]) -> (f64, f64) {
 pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
     sys: S,
     ctx: &Context,
-    rec: &'r mut Rec,
+    rec: Sink<'r, Rec>,
 ) -> Result<RunOut<'r, Rec>, SimError> {
     let mut sampler = ctx.sampler(rec);
     let mut turns = Turns::new(ctx.periodic);
