@@ -41,7 +41,10 @@ pub(in crate::sim) struct Context {
 
 impl Context {
     /// The run's sampler, started at t = 0 from the initial state.
-    pub(in crate::sim) fn sampler<'r, Rec: Recorder>(&self, sink: Sink<'r, Rec>) -> Sampler<'r, Rec> {
+    pub(in crate::sim) fn sampler<'r, Rec: Recorder>(
+        &self,
+        sink: Sink<'r, Rec>,
+    ) -> Sampler<'r, Rec> {
         let mut sampler = Sampler::new(
             self.schedule,
             self.strobes_total,
