@@ -14,9 +14,8 @@ use crate::{csv_out, plot};
 use kapitza_core::integrate::Symplectic;
 use kapitza_core::math;
 use kapitza_core::model::equilibria;
-use kapitza_core::sim::fidelity;
 use kapitza_core::sim::scene::{Fidelity, FidelityChoice};
-use kapitza_core::sim::{simulate, Format, Method, Options, Report};
+use kapitza_core::sim::{Format, Method, Options, PlannedRun, Report};
 
 /// Simulate a scene file (TOML; keys in docs/scenes.md) and report the outcome: rest (at which
 /// angle), flutter, subharmonic, rotation, chaotic tumbling or oscillation.
@@ -174,39 +173,42 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     if let Some(dir) = &args.out {
         crate::chart::draw::prepare_dir(dir)?;
     }
-    let p = file.scene.physical().map_err(|e| anyhow!("{name}: {e}"))?;
-    let period = math::TAU / p.omega;
+    let options = Options {
+        method: file.method,
+        controller: file.controller,
+        format: file.format,
+        seed: file.seed,
+        ..Options::default()
+    };
+    let mut planned = PlannedRun::new(&file.scene, &options).map_err(|e| anyhow!("{name}: {e}"))?;
+    // The output is sized from the plan: its duration, and whether the averaged model runs
+    // (its slow state has no fast wobble to resolve).
+    let period = math::TAU / planned.physical.omega;
     let plan = match &args.out {
         Some(_) => {
-            let averaged =
-                fidelity::decide(&file.scene, &p).is_ok_and(|d| d.fidelity == Fidelity::Averaged);
+            let averaged = planned.decision.fidelity == Fidelity::Averaged;
             let plan = Plan::new(
                 period,
-                file.scene.duration(p.omega) / period,
+                planned.duration() / period,
                 args.samples_per_period,
                 args.window.periods(period),
                 !averaged,
             )
             .map_err(|e| anyhow!("{e}"))?;
+            planned
+                .sample_every(plan.dt)
+                .map_err(|e| anyhow!("{name}: {e}"))?;
             Some(plan)
         }
         None => None,
     };
-    let options = Options {
-        method: file.method,
-        controller: file.controller,
-        format: file.format,
-        out_dt: plan.map_or(0.0, |p| p.dt),
-        seed: file.seed,
-        ..Options::default()
-    };
     let mut rec = Collect::new(plan);
     let start = Instant::now();
-    let result = simulate(&file.scene, &options, &mut rec);
+    let result = planned.run(&mut rec);
     let wall = start.elapsed().as_secs_f64();
     rec.finish();
     let report = result.map_err(|e| anyhow!("{name}: {e}"))?;
-    let summary = summarise(&name, &file, &args.set, &report, wall)?;
+    let summary = summarise(&name, &file, &args.set, &report, planned.r_effective, wall)?;
     let mut written = Vec::new();
     if let Some(dir) = &args.out {
         written = write_out(dir, &file, &summary, &rec)?;
@@ -238,12 +240,12 @@ fn summarise(
     file: &SceneFile,
     sets: &[String],
     report: &Report,
+    r_effective: f64,
     wall: f64,
 ) -> Result<Summary> {
     let p = &report.physical;
     let scene = &file.scene;
     let outcome = OutcomeOut::from(report.outcome);
-    let r_effective = kapitza_core::sim::run::averaged_r(scene, p);
     let eqs = equilibria(r_effective, scene.drive.angle).context("predicted equilibria")?;
     let predicted = eqs
         .as_slice()

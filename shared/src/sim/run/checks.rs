@@ -65,7 +65,11 @@ pub(super) fn check_method(
         }
         Method::Dop853 { rtol, atol } => tolerances(rtol, atol)?,
     }
-    let out_dt = options.out_dt;
+    output_interval(options.out_dt, t_end)
+}
+
+/// The time series' sampling interval: 0 (none) or at most [`MAX_OUTPUT_SAMPLES`] samples.
+pub(super) fn output_interval(out_dt: f64, t_end: f64) -> Result<(), SimError> {
     if !(out_dt == 0.0 || (out_dt > 0.0 && t_end / out_dt <= MAX_OUTPUT_SAMPLES)) {
         return Err(SimError::Unsupported(
             "the output interval must be 0 (none) or a finite number > 0 giving at most 1e9 samples",

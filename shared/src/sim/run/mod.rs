@@ -18,7 +18,7 @@ mod stepping;
 
 pub(super) use compose::{Job, RunOut};
 pub(super) use plan::Context;
-pub use plan::{averaged_r, PlannedRun};
+pub use plan::PlannedRun;
 pub(super) use stepping::Dense;
 
 use super::classify::Outcome;

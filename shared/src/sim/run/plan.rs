@@ -2,7 +2,7 @@
 //! physical constants, the fidelity decision, the duration and strobe count, the drive schedule,
 //! the start state, the averaged model's R and wobble), so nothing downstream derives it again.
 
-use super::checks::check_method;
+use super::checks::{check_method, output_interval};
 use super::compose::finish;
 use super::{EndState, Format, Method, Options, Report, SimError};
 use crate::math;
@@ -69,7 +69,7 @@ pub struct PlannedRun {
     pub a1: f64,
     /// a2/ℓ of a slider-crank's second harmonic ([`second_harmonic`]); 0 without one.
     pub a2: f64,
-    /// R of the averaged model ([`averaged_r`]).
+    /// R of the averaged model: R (1 + A²/(4b²)) with a slider-crank of rod length b.
     pub r_effective: f64,
     /// Whether the drive signal is shaped (ramp, actuator lag, slider-crank) or the steady sinusoid.
     pub shaped: bool,
@@ -145,6 +145,14 @@ impl PlannedRun {
         self.ctx.t_end
     }
 
+    /// Samples the time series every `dt` seconds (0: none). For a caller that sizes its output
+    /// from the plan's duration and fidelity, which are only known once the scene is planned.
+    pub fn sample_every(&mut self, dt: f64) -> Result<(), SimError> {
+        output_interval(dt, self.ctx.t_end)?;
+        self.ctx.out_dt = dt;
+        Ok(())
+    }
+
     /// Steps the planned run, sampling into `rec`, and classifies the outcome.
     pub fn run<Rec: Recorder>(&self, rec: &mut Rec) -> Result<Report, SimError> {
         match self.format {
@@ -207,7 +215,7 @@ fn second_harmonic(scene: &Scene, p: &Physical) -> f64 {
 
 /// R of the averaged model: R (1 + 4 (a2/a1)²) = R (1 + A²/(4b²)) with a slider-crank of rod
 /// length b (see [`crate::sim::eom`]); R itself otherwise.
-pub fn averaged_r(scene: &Scene, p: &Physical) -> f64 {
+fn averaged_r(scene: &Scene, p: &Physical) -> f64 {
     let ratio = second_harmonic(scene, p) / (p.amplitude / p.ell);
     p.r * (1.0 + 4.0 * ratio * ratio)
 }
