@@ -161,9 +161,45 @@ pub fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, fa: f64) -> f64 {
     a + 0.5 * (b - a)
 }
 
+/// Narrows [lo, hi] around where `flipped` turns from false (at lo) to true (at hi), halving
+/// until the bracket is at most `tol` wide or no float lies inside it (tol = 0: adjacent floats,
+/// within 200 halvings).
+/// For questions that are yes/no rather than a sign: a Sturm count, a trace above a threshold.
+pub fn bisect_flip(
+    mut flipped: impl FnMut(f64) -> bool,
+    mut lo: f64,
+    mut hi: f64,
+    tol: f64,
+) -> (f64, f64) {
+    for _ in 0..200 {
+        let mid = lo + 0.5 * (hi - lo);
+        if hi - lo <= tol || mid <= lo || mid >= hi {
+            break;
+        }
+        if flipped(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    (lo, hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bisect_flip_brackets_the_flip() {
+        // x² ≥ 2 flips at √2 (closed form): to adjacent floats with tol = 0, else to width ≤ tol.
+        let (lo, hi) = bisect_flip(|x| x * x >= 2.0, 1.0, 2.0, 0.0);
+        assert!(lo * lo < 2.0 && hi * hi >= 2.0);
+        assert_eq!(hi, f64::from_bits(lo.to_bits() + 1));
+        let (lo, hi) = bisect_flip(|x| x * x >= 2.0, 1.0, 2.0, 1e-3);
+        assert!(
+            hi - lo <= 1e-3 && lo < core::f64::consts::SQRT_2 && core::f64::consts::SQRT_2 <= hi
+        );
+    }
 
     #[test]
     fn pow_rough_is_within_1e5_of_libm() {

@@ -121,19 +121,12 @@ pub fn eigenvalue(nu: f64, q: f64, index: u32) -> f64 {
     // Gershgorin: every eigenvalue lies within 2|q| of a diagonal entry (ν + 2r)².
     let top = nu.abs() + 2.0 * f64::from(index) + 2.0;
     let n = harmonics(top * top + 2.0 * q.abs(), q);
-    let mut lo = -2.0 * q.abs() - 1.0;
-    let mut hi = top * top + 2.0 * q.abs() + 1.0;
-    for _ in 0..200 {
-        let mid = lo + 0.5 * (hi - lo);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if count_below(nu, q, mid, n) > index {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
+    let (lo, hi) = math::bisect_flip(
+        |x| count_below(nu, q, x, n) > index,
+        -2.0 * q.abs() - 1.0,
+        top * top + 2.0 * q.abs() + 1.0,
+        0.0,
+    );
     lo + 0.5 * (hi - lo)
 }
 

@@ -57,27 +57,13 @@ impl Probe<'_> {
     /// if `rising`, else g(a) > 0 ≥ g(b)); returns (midpoint, b-side end).
     fn bisect(
         &mut self,
-        mut a: f64,
-        mut b: f64,
+        a: f64,
+        b: f64,
         tol: f64,
         rising: bool,
         g: fn((f64, f64, f64)) -> f64,
     ) -> (f64, f64) {
-        for _ in 0..200 {
-            if b - a <= tol {
-                break;
-            }
-            let mid = 0.5 * (a + b);
-            if mid <= a || mid >= b {
-                break;
-            }
-            let v = g(self.eval(mid));
-            if (v > 0.0) == rising {
-                b = mid;
-            } else {
-                a = mid;
-            }
-        }
+        let (a, b) = math::bisect_flip(|m| (g(self.eval(m)) > 0.0) == rising, a, b, tol);
         (0.5 * (a + b), b)
     }
 }
@@ -205,19 +191,7 @@ impl Floquet {
                 if at_l == above(p.eval(u)) {
                     End::Missing(TRACE_NOT_REACHED)
                 } else {
-                    let mut a = l;
-                    let mut b = u;
-                    for _ in 0..200 {
-                        let mid = 0.5 * (a + b);
-                        if b - a <= tol || mid <= a || mid >= b {
-                            break;
-                        }
-                        if above(p.eval(mid)) == at_l {
-                            a = mid;
-                        } else {
-                            b = mid;
-                        }
-                    }
+                    let (a, b) = math::bisect_flip(|m| above(p.eval(m)) != at_l, l, u, tol);
                     End::Value(0.5 * (a + b))
                 }
             }
