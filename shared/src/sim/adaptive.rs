@@ -19,7 +19,7 @@
 //! Hermite interpolant ([`Span`]), without evaluations.
 
 use super::eom::{AveragedEom, FullEom, NoExtra};
-use super::run::{Context, EndState, RunOut, SimError};
+use super::run::{Context, RunOut, SimError};
 use super::sampling::{Interpolant, Recorder, Sink};
 use super::signal::DriveSignal;
 use super::slow_series::{self, SlowSeries};
@@ -173,11 +173,7 @@ pub(super) fn run<'r, R: Real, A: Accel<R>, Rec: Recorder, const S: usize>(
     Ok(RunOut {
         sampler,
         work,
-        end: EndState {
-            t,
-            theta: y.0.to_f64() + turns.offset(),
-            rate: y.1.to_f64(),
-        },
+        end: turns.end_state(t, y.0, y.1),
         sticks: None,
     })
 }

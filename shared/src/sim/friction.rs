@@ -22,7 +22,7 @@
 //! (physics §5).
 
 use super::eom::{FullEom, NoExtra, Sliding};
-use super::run::{Context, Dense, EndState, Method, RunOut, SimError};
+use super::run::{Context, Dense, Method, RunOut, SimError};
 use super::sampling::{Interpolant, Recorder, Sampler, Sink};
 use super::signal::DriveSignal;
 use super::turns::{Shifted, Turns};
@@ -140,11 +140,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     Ok(RunOut {
         sampler,
         work,
-        end: EndState {
-            t,
-            theta: theta + turns.offset(),
-            rate,
-        },
+        end: turns.end_state(t, theta, rate),
         sticks: Some(sticks),
     })
 }

@@ -17,7 +17,7 @@
 //! slider-crank) and viscous damping or none: [`super::run`] refuses the rest by name.
 
 use super::eom::{FullEom, NoExtra};
-use super::run::{Context, EndState, RunOut, SimError};
+use super::run::{Context, RunOut, SimError};
 use super::sampling::{Hermite, Interpolant, Recorder, Sink};
 use super::signal::DriveSignal;
 use super::turns::{Shifted, Turns};
@@ -211,11 +211,7 @@ pub(super) fn run<'r, R: Real, D: DriveSignal<R>, Rec: Recorder>(
     Ok(RunOut {
         sampler,
         work,
-        end: EndState {
-            t,
-            theta: y.0.to_f64() + turns.offset(),
-            rate: y.1.to_f64(),
-        },
+        end: turns.end_state(t, y.0, y.1),
         sticks: None,
     })
 }

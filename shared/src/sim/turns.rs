@@ -7,6 +7,7 @@
 //! by whole turns, counted here in an integer, and every sample and result adds them back in f64.
 //! Reduction waits until |θ| > 3π, so that motion about ±π (the inverted pendulum) is never split.
 
+use super::run::EndState;
 use super::sampling::Interpolant;
 use crate::{math, Real};
 
@@ -29,6 +30,15 @@ impl Turns {
     /// What to add to an integrated angle to get the true one (rad).
     pub fn offset(&self) -> f64 {
         self.count as f64 * math::TAU
+    }
+
+    /// A run's end state with its whole turns put back.
+    pub fn end_state<R: Real>(&self, t: f64, theta: R, rate: R) -> EndState {
+        EndState {
+            t,
+            theta: theta.to_f64() + self.offset(),
+            rate: rate.to_f64(),
+        }
     }
 
     /// Whether θ has gone far enough to be reduced (never for ±∞ or NaN: a run that blew up

@@ -3,7 +3,7 @@
 
 use super::compose::RunOut;
 use super::plan::Context;
-use super::{EndState, Method, SimError};
+use super::{Method, SimError};
 use crate::integrate::{
     rk4_observe, symplectic_fixed, Control, Dop853, Force, IntegrateError, Phase, Stats, Step,
     StepControl, Symplectic, System,
@@ -107,11 +107,7 @@ pub(super) fn integrate<'r, R: Real, S: System<2, R>, Rec: Recorder>(
             return Err(SimError::Integrate(IntegrateError::NonFinite { t }));
         }
     }
-    let end = EndState {
-        t,
-        theta: y[0].to_f64() + turns.offset(),
-        rate: y[1].to_f64(),
-    };
+    let end = turns.end_state(t, y[0], y[1]);
     Ok(RunOut {
         sampler,
         work,
