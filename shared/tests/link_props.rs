@@ -51,6 +51,7 @@ fn field() -> impl Strategy<Value = ConfigField> {
         Just(ConfigField::Rates),
         Just(ConfigField::CrankSign),
         Just(ConfigField::ClosedLoopRateMax),
+        Just(ConfigField::ConnectingRod),
         Just(ConfigField::Other),
     ]
 }

@@ -9,6 +9,7 @@ use kapitza_core::calib::{current, direction, plumb, ringdown, servo_fit, stroke
 use kapitza_core::link::convert::from_q16;
 use kapitza_core::link::message::Mode;
 use kapitza_core::math;
+use kapitza_core::model::slider_crank::SliderCrank;
 use kapitza_core::model::Geometry;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::Angle;
@@ -429,13 +430,22 @@ impl<'a> Calibrator<'a> {
         };
         let first = measure(math::to_rad(STROKE_DEG))?;
         let r_true = first * first * omega * omega / (2.0 * g * ell);
-        let theta_d = plumb::drive_angle(phi0, r_true).map_err(|e| refused(Step::Stroke, e))?;
+        let crank = |amplitude: f64| {
+            (self.cfg.connecting_rod > 0.0).then_some(SliderCrank {
+                amplitude,
+                rod: self.cfg.connecting_rod,
+                ell,
+            })
+        };
+        let theta_d = plumb::drive_angle(phi0, r_true, crank(first).as_ref())
+            .map_err(|e| refused(Step::Stroke, e))?;
         let a = measure(theta_d)?;
         let mount = math::to_deg(theta_d);
+        let gain = crank(a).map_or(1.0, |c| c.strength_gain());
         r.measured("wobble_rad", wobble);
         r.measured("omega", omega);
         r.measured("lean_deg", math::to_deg(phi0));
-        r.measured("r_in_situ", a * a * omega * omega / (2.0 * g * ell));
+        r.measured("r_in_situ", gain * a * a * omega * omega / (2.0 * g * ell));
         r.measured("mount_deg", mount);
         self.cfg.amplitude = a;
         r.wrote("amplitude", a);

@@ -51,6 +51,8 @@ pub struct Args {
 struct ConfigFile {
     /// Drive amplitude A (m): half the peak-to-peak stroke.
     amplitude: f64,
+    /// The connecting rod (m) from the crank pin to the carriage; 0 for a pure sine.
+    connecting_rod: f64,
     gravity: f64,
     sample_hz: u32,
     control_hz: u32,
@@ -136,6 +138,7 @@ impl From<&RigConfig> for ConfigFile {
         let m = &c.motor;
         Self {
             amplitude: c.amplitude,
+            connecting_rod: c.connecting_rod,
             gravity: c.gravity,
             sample_hz: c.sample_hz,
             control_hz: c.control_hz,
@@ -183,6 +186,7 @@ impl From<&ConfigFile> for RigConfig {
         let m = &f.motor;
         Self {
             amplitude: f.amplitude,
+            connecting_rod: f.connecting_rod,
             gravity: f.gravity,
             sample_hz: f.sample_hz,
             control_hz: f.control_hz,

@@ -193,6 +193,7 @@ struct RawInitial {
 struct RawConfigured {
     pendulum: Option<RawPendulum>,
     amplitude: Option<f64>,
+    connecting_rod: Option<f64>,
     gravity: Option<f64>,
     duty_max: Option<f64>,
     #[serde(default)]
@@ -403,6 +404,9 @@ fn convert(raw: RawRig) -> Result<RigFile> {
         }
         if let Some(a) = c.amplitude {
             config.amplitude = positive("configured.amplitude", a)?;
+        }
+        if let Some(b) = c.connecting_rod {
+            config.connecting_rod = b;
         }
         if let Some(g) = c.gravity {
             config.gravity = positive("configured.gravity", g)?;

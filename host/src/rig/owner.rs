@@ -90,7 +90,7 @@ pub enum Event {
     /// The line is back (the version checked again).
     LinkBack,
     /// A socket client's request was relayed (what it was, for the event log).
-    Relayed(Request),
+    Relayed(Box<Request>),
 }
 
 /// The owner of one rig's port.
@@ -258,7 +258,7 @@ impl Owner {
                 Some(Response::Ok)
             }
             req => {
-                events.push(Event::Relayed(req));
+                events.push(Event::Relayed(Box::new(req)));
                 match self.session.as_mut().map(|s| s.client.request(req)) {
                     Some(Ok(r)) => Some(r),
                     Some(Err(Error::Refused(r))) => Some(Response::Refused(r)),

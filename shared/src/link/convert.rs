@@ -141,6 +141,7 @@ impl From<RigConfig> for WireConfig {
     fn from(c: RigConfig) -> Self {
         let RigConfig {
             amplitude,
+            connecting_rod,
             geometry,
             gravity,
             limits:
@@ -173,6 +174,7 @@ impl From<RigConfig> for WireConfig {
         } = c;
         Self {
             amplitude,
+            connecting_rod,
             geometry: geometry.into(),
             gravity,
             omega_max,
@@ -204,6 +206,7 @@ impl From<WireConfig> for RigConfig {
     fn from(w: WireConfig) -> Self {
         let WireConfig {
             amplitude,
+            connecting_rod,
             geometry,
             gravity,
             omega_max,
@@ -230,6 +233,7 @@ impl From<WireConfig> for RigConfig {
         } = w;
         Self {
             amplitude,
+            connecting_rod,
             geometry: geometry.into(),
             gravity,
             limits: Limits {

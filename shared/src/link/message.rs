@@ -78,6 +78,8 @@ impl Request {
 }
 
 /// From the rig to the laptop.
+// No heap on the rig: the configuration travels inline, as in `Request`.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, MaxSize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Response {
@@ -366,6 +368,7 @@ pub enum WireGeometry {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct WireConfig {
     pub amplitude: f64,
+    pub connecting_rod: f64,
     pub geometry: WireGeometry,
     pub gravity: f64,
     pub omega_max: f64,

@@ -96,6 +96,7 @@ pub enum ConfigField {
     QuietBlocks,
     ClosedLoopBand,
     ClosedLoopRateMax,
+    ConnectingRod,
     Other,
 }
 
@@ -135,6 +136,7 @@ impl ConfigField {
             "quiet_blocks" => Self::QuietBlocks,
             "closed_loop_band" => Self::ClosedLoopBand,
             "closed_loop_rate_max" => Self::ClosedLoopRateMax,
+            "connecting_rod" => Self::ConnectingRod,
             _ => Self::Other,
         }
     }
@@ -173,6 +175,7 @@ impl ConfigField {
             Self::QuietBlocks => "calibration.quiet_blocks",
             Self::ClosedLoopBand => "closed_loop.band",
             Self::ClosedLoopRateMax => "closed_loop.rate_max",
+            Self::ConnectingRod => "connecting_rod",
             Self::Other => "a configuration value",
         }
     }

@@ -9,12 +9,14 @@
 //! | [`trig`] | degree-2 trigonometric polynomials and all their roots on the circle |
 //! | [`equilibria`] | every equilibrium of the averaged motion, with its stability; the effective potential and energy |
 //! | [`infer`] | R inferred from a settled angle |
+//! | [`slider_crank`] | the slider-crank's second harmonic in the averaged theory |
 
 pub mod drive;
 pub mod equilibria;
 pub mod geometry;
 pub mod groups;
 pub mod infer;
+pub mod slider_crank;
 pub mod trig;
 
 pub use drive::{Drive, DriveAngle};

@@ -22,13 +22,15 @@
 //!
 //! | version | payload | missing fields load as |
 //! |---|---|---|
-//! | 1 | [`v1::ConfigV1`] | `duty_max` 1, [`crate::rig::calibration::Calibration::DEFAULT`], closed loop off |
-//! | 2 | [`WireConfig`] | — |
+//! | 1 | [`v1::ConfigV1`] | `duty_max` 1, [`crate::rig::calibration::Calibration::DEFAULT`], closed loop off, no connecting rod |
+//! | 2 | [`v2::ConfigV2`] | no connecting rod (`connecting_rod` 0) |
+//! | 3 | [`WireConfig`] | — |
 //!
 //! The origin stays [`ConfigOrigin::Stored`]; the record is rewritten in the new format at the
 //! next accepted `SetConfig`. Any other version is [`Fallback::Incompatible`].
 
 pub mod v1;
+pub mod v2;
 
 use postcard::experimental::max_size::MaxSize;
 use serde::Deserialize;
@@ -41,7 +43,7 @@ use crate::rig::config::RigConfig;
 /// "KPZC".
 pub const MAGIC: [u8; 4] = *b"KPZC";
 /// The record format version.
-pub const RECORD_VERSION: u16 = 2;
+pub const RECORD_VERSION: u16 = 3;
 const HEAD: usize = 8;
 /// The largest record, padding included: what the firmware reserves and writes.
 pub const RECORD_MAX: usize = (HEAD + WireConfig::POSTCARD_MAX_SIZE + 4).div_ceil(8) * 8;
@@ -90,6 +92,7 @@ pub fn decode(bytes: &[u8]) -> Result<RigConfig, Fallback> {
     }
     let cfg = match version {
         1 => RigConfig::from(payload::<v1::ConfigV1>(&body[HEAD..])?),
+        2 => RigConfig::from(payload::<v2::ConfigV2>(&body[HEAD..])?),
         RECORD_VERSION => RigConfig::from(payload::<WireConfig>(&body[HEAD..])?),
         _ => return Err(Fallback::Incompatible { version }),
     };
@@ -149,6 +152,7 @@ mod tests {
         cfg.calibration.crank_sign = -1;
         cfg.closed_loop.enabled = true;
         cfg.limits.duty_max = 0.8;
+        cfg.connecting_rod = 0.06;
         encode(&cfg, &mut buf);
         assert_eq!(decode(&buf), Ok(cfg));
     }
@@ -159,10 +163,10 @@ mod tests {
         encode(&RigConfig::REFERENCE, &mut buf);
         // Re-seal with another version number: intact, but not ours.
         let n = usize::from(u16::from_le_bytes([buf[6], buf[7]]));
-        buf[4] = 3;
+        buf[4] = 4;
         let crc = CRC.checksum(&buf[..HEAD + n]);
         buf[HEAD + n..HEAD + n + 4].copy_from_slice(&crc.to_le_bytes());
-        assert_eq!(decode(&buf), Err(Fallback::Incompatible { version: 3 }));
+        assert_eq!(decode(&buf), Err(Fallback::Incompatible { version: 4 }));
         // Intact but out of range.
         let mut bad = RigConfig::REFERENCE;
         bad.gravity = -1.0;

@@ -40,6 +40,7 @@ impl From<ConfigV1> for RigConfig {
     fn from(v: ConfigV1) -> Self {
         Self {
             amplitude: v.amplitude,
+            connecting_rod: 0.0,
             geometry: v.geometry.into(),
             gravity: v.gravity,
             limits: Limits {

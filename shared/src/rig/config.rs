@@ -5,15 +5,19 @@
 //! code comes from [`RigConfig::derived`].
 //!
 //! ```text
-//! R = A²ω²/(2gℓ)  ⇔  ω = ωc √R,  ωc = √(2gℓ)/A        (physics §3; model::groups::omega_for_r)
+//! R = A²ω²/(2gℓ) · G  ⇔  ω = ωc √(R/G),  ωc = √(2gℓ)/A     (physics §3, §5.1)
 //! A: amplitude of the pivot's motion, half its peak-to-peak stroke (the crank radius)
+//! G = 1 + (A/2b)² with a connecting rod b (model::slider_crank), else 1
 //! ```
+//! R is the drive strength the averaged theory sees: the one a demo asks for and the rig
+//! measures in situ.
 
 use super::calibration::Calibration;
 use super::closed_loop::ClosedLoopR;
 use super::fixed::{Angle, RadPerSec};
 use crate::error::{positive, ParamError};
 use crate::model::groups::omega_for_r;
+use crate::model::slider_crank::SliderCrank;
 use crate::model::Geometry;
 
 /// Limits that no command may push the rig past (physics §7, "Safety").
@@ -62,6 +66,10 @@ pub struct MotorConfig {
 pub struct RigConfig {
     /// Drive amplitude A (m): half the peak-to-peak stroke.
     pub amplitude: f64,
+    /// The connecting rod b (m) from the crank pin to the carriage, whose second harmonic
+    /// (A²/4b) cos 2ψ raises R by (A/2b)² and pushes the slow angle ([`SliderCrank`]); 0 for a
+    /// pure sine (a scotch yoke or a cam).
+    pub connecting_rod: f64,
     pub geometry: Geometry,
     pub gravity: f64,
     pub limits: Limits,
@@ -97,6 +105,7 @@ impl RigConfig {
     /// R = 3 at ω = 313 rad/s, 50 Hz), a brushed motor reaching 500 rad/s at full duty.
     pub const REFERENCE: Self = Self {
         amplitude: 0.010,
+        connecting_rod: 0.0,
         geometry: Geometry::Rod { length: 0.25 },
         gravity: 9.81,
         limits: Limits {
@@ -130,6 +139,17 @@ impl RigConfig {
     pub fn validate(self) -> Result<Self, ParamError> {
         positive("amplitude", self.amplitude)?;
         positive("gravity", self.gravity)?;
+        // The expansion A cos ψ + (A²/4b) cos 2ψ needs b well past the crank radius; below 2A
+        // the carriage could not follow the crank at all.
+        if !(self.connecting_rod == 0.0
+            || (self.connecting_rod.is_finite() && self.connecting_rod > 2.0 * self.amplitude))
+        {
+            return Err(too_big(
+                "connecting_rod",
+                self.connecting_rod,
+                "0 (a pure sine) or longer than 2 amplitudes (m)",
+            ));
+        }
         // A decoded configuration builds the body as a literal: check it as its constructor would.
         self.geometry.validate()?;
         let ell = positive("equivalent length", self.geometry.equivalent_length())?;
@@ -238,14 +258,30 @@ impl RigConfig {
         self.geometry.equivalent_length()
     }
 
-    /// ω that gives drive strength R with this stroke and pendulum: ω = ωc √R.
-    pub fn omega_for_r(&self, r: f64) -> Result<f64, ParamError> {
-        omega_for_r(r, self.ell(), self.gravity, self.amplitude)
+    /// The slider-crank, if the drive has a connecting rod.
+    pub fn slider_crank(&self) -> Option<SliderCrank> {
+        (self.connecting_rod > 0.0).then(|| SliderCrank {
+            amplitude: self.amplitude,
+            rod: self.connecting_rod,
+            ell: self.ell(),
+        })
     }
 
-    /// R = A²ω²/(2gℓ) at drive ω.
+    /// R_e / R of the first harmonic alone: 1 + (A/2b)², or 1 for a pure sine.
+    pub fn strength_gain(&self) -> f64 {
+        self.slider_crank().map_or(1.0, |c| c.strength_gain())
+    }
+
+    /// ω that gives drive strength R with this stroke and pendulum: ω = ωc √(R/G).
+    pub fn omega_for_r(&self, r: f64) -> Result<f64, ParamError> {
+        omega_for_r(r, self.ell(), self.gravity, self.amplitude)
+            .map(|w| w / crate::math::sqrt(self.strength_gain()))
+    }
+
+    /// R = G A²ω²/(2gℓ) at drive ω.
     pub fn r_for_omega(&self, omega: f64) -> f64 {
-        self.amplitude * self.amplitude * omega * omega / (2.0 * self.gravity * self.ell())
+        self.strength_gain() * self.amplitude * self.amplitude * omega * omega
+            / (2.0 * self.gravity * self.ell())
     }
 
     /// ω0 = √(g/ℓ).
@@ -349,5 +385,26 @@ mod tests {
         c.closed_loop.rate_max = 0.0;
         assert_eq!(c.validate().unwrap_err().name, "closed_loop_rate_max");
         assert!(RigConfig::REFERENCE.omega_for_r(-1.0).is_err());
+        for (rod, ok) in [(0.0, true), (0.05, true), (0.02, false), (-0.05, false)] {
+            let mut c = RigConfig::REFERENCE;
+            c.connecting_rod = rod;
+            assert_eq!(c.validate().is_ok(), ok, "{rod}");
+        }
+        let mut c = RigConfig::REFERENCE;
+        c.connecting_rod = f64::NAN;
+        assert_eq!(c.validate().unwrap_err().name, "connecting_rod");
+    }
+
+    #[test]
+    fn a_connecting_rod_raises_r_by_its_gain() {
+        // physics §5.1: a 10 mm crank on a 50 mm rod, G = 1 + (10/100)² = 1.01; the ω for an R
+        // falls by √G, and R at that ω is R again.
+        let mut c = RigConfig::REFERENCE;
+        c.connecting_rod = 0.05;
+        let c = c.validate().unwrap();
+        let w = c.omega_for_r(3.0).unwrap();
+        let pure = RigConfig::REFERENCE.omega_for_r(3.0).unwrap();
+        assert!((w - pure / 1.01f64.sqrt()).abs() < 1e-9, "{w} vs {pure}");
+        assert!((c.r_for_omega(w) - 3.0).abs() < 1e-12);
     }
 }

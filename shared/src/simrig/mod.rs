@@ -120,6 +120,7 @@ impl Params {
     pub fn configured(&self) -> RigConfig {
         RigConfig {
             amplitude: self.amplitude,
+            connecting_rod: self.connecting_rod.unwrap_or(0.0),
             geometry: self.geometry,
             gravity: self.gravity,
             ..RigConfig::REFERENCE
