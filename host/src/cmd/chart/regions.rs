@@ -287,7 +287,9 @@ impl Figure for RegionsFigure<'_> {
                 chart
                     .draw_series([Text::new(
                         format!("R = {}: {f:.1}° … {t:.1}°", b.r),
-                        (0.5 * (f + t) - 18.0, b.r + 0.075),
+                        // Below its line, inside the arch: above it the top band's label
+                        // would cross the saddle-node curve.
+                        (0.5 * (f + t) - 18.0, b.r - 0.035),
                         ("sans-serif", draw::LEGEND_FONT).into_font().color(&BAND),
                     )])
                     .map_err(pe)?;
