@@ -371,6 +371,18 @@ impl<'a> Calibrator<'a> {
         self.op.say(&format!(
             "stroke: the stroke from the fast wobble, hanging at R = {STROKE_R} across the drive"
         ))?;
+        let rod = self.cfg.connecting_rod;
+        self.op.say(&if rod > 0.0 {
+            format!(
+                "  the plumb line allows for the configured connecting rod, {:.1} mm (measure it \
+                 and `kapitza config set` it if it is not)",
+                rod * 1e3
+            )
+        } else {
+            "  no connecting rod configured: the stroke is taken as a pure sine (set \
+             `connecting_rod` first if the crank drives the carriage through a rod)"
+                .to_string()
+        })?;
         self.idle()?;
         self.op.ask(&format!(
             "the drive will run at R = {STROKE_R}, θd = {STROKE_DEG}° for about 20 s with the \
