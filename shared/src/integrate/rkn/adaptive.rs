@@ -33,6 +33,13 @@ pub trait Accel<R: Real> {
     /// g at (t, θ), inside the step whose start gave `base`; `offset` = θ − θ0 (formed without
     /// the rounding of that difference).
     fn accel(&self, base: &Self::Base, t: f64, theta: R, offset: R) -> R;
+    /// g at (t, θ) and e + f g: the next stage's offset, which an implementation may form
+    /// without waiting for g's last operation (the stages' chain runs through it).
+    #[inline(always)]
+    fn accel_then(&self, base: &Self::Base, t: f64, theta: R, offset: R, (f, e): (R, R)) -> (R, R) {
+        let g = self.accel(base, t, theta, offset);
+        (g, e + f * g)
+    }
 }
 
 /// The settings of an adaptive RKN 8(6) run.
@@ -193,8 +200,8 @@ impl AdaptiveRkn {
             let t_new = if last { t1 } else { t + h };
             h = t_new - t;
             let m = Damped::of(pair, h, c, !sys.autonomous());
-            let out = m.step_from(y.0, y.1, g0, |i, th, d| {
-                sys.accel(&base, t + m.tau[i], th, d)
+            let out = m.step_from(y.0, y.1, g0, |i, th, d, next| {
+                sys.accel_then(&base, t + m.tau[i], th, d, next)
             });
             stats.rhs_evals += S as u64 - 1;
             let err = scaled(out.error.0, y.0, out.theta).max(scaled(out.error.1, y.1, out.rate));

@@ -182,52 +182,67 @@ impl<const S: usize> Damped<S> {
         g0: R,
         mut g: impl FnMut(usize, R) -> R,
     ) -> RknStep<R> {
-        self.step_from(theta, rate, g0, |i, th, _| g(i, th))
+        self.step_from(theta, rate, g0, |i, th, _, (f, e)| {
+            let gi = g(i, th);
+            (gi, e + f * gi)
+        })
     }
 
     /// [`Damped::step`] with g also handed each stage's offset δ = θ_i − θ from the step's
-    /// start, computed without the rounding of θ_i − θ: `g(i, θ_i, δ_i)`.
+    /// start, computed without the rounding of θ_i − θ, and the next stage's offset in two
+    /// parts (f, e) such that δ_{i+1} = e + f g_i: `g(i, θ_i, δ_i, (f, e))` returns
+    /// (g_i, e + f g_i), and may form the second without waiting for the first ((0, 0) where
+    /// the next stage does not use g_i).
     ///
     /// Every stage waits for an earlier one's g, so the arithmetic between two evaluations is
-    /// the step's latency. The stage offset is formed as
-    /// δ_i = ((c_i S θ' + S² Σ_{j<i−2} a_ij w_j g_j) + S² a_{i,i−2} w_{i−2} g_{i−2}) + S² a_{i,i−1} w_{i−1} g_{i−1}
-    /// (w_j: the damping weights; w_0 = 1, known without a division): the long sum is ready
-    /// well before g_{i−1} is, and only one multiply and one add stand between g_{i−1} and
-    /// stage i. A row that skips its predecessor ([`Pair::waits_for`]) does not wait for it.
+    /// the step's latency. The offset is
+    /// δ_{i+1} = ((c_{i+1} S θ' + S² Σ_{j<i−1} a_{i+1,j} w_j g_j) + S² a_{i+1,i−1} w_{i−1} g_{i−1}) + S² a_{i+1,i} w_i g_i
+    /// (w_j: the damping weights; w_0 = 1, known without a division): all but the last term
+    /// is ready before g_i is. A row that skips its predecessor ([`Pair::waits_for`]) does
+    /// not wait for it.
     #[inline(always)]
     pub fn step_from<R: Real>(
         &self,
         theta: R,
         rate: R,
         g0: R,
-        mut g: impl FnMut(usize, R, R) -> R,
+        mut g: impl FnMut(usize, R, R, (R, R)) -> (R, R),
     ) -> RknStep<R> {
         let p = self.pair;
         let s = R::from_f64(self.s);
         let s2 = R::from_f64(self.s * self.s);
         let weight = |i: usize| if p.c[i] == 0.0 { 1.0 } else { self.weight[i] };
         // S² a_ij w_j, the factor of g_j in stage i's offset.
-        let factor = |i: usize, j: usize| R::from_f64(self.s * self.s * p.a[i][j] * weight(j));
-        // k[j] = w_j g_j: the transformed acceleration at stage j; g_{i−1}, g_{i−2} in hand.
+        let factor = |i: usize, j: usize| s2 * R::from_f64(p.a[i][j] * weight(j));
+        // k[j] = w_j g_j: the transformed acceleration at stage j.
         let mut k = [R::ZERO; S];
         k[0] = R::from_f64(weight(0)) * g0;
-        let (mut prev, mut prev2) = (g0, R::ZERO);
+        // c_i S θ' + S² Σ_{j<n} a_ij w_j g_j.
+        let early = |i: usize, n: usize, k: &[R; S]| {
+            R::from_f64(p.c[i]) * s * rate + s2 * dot(&p.a[i][..n], &k[..n])
+        };
+        let mut prev = g0;
+        let mut d = early(1, 0, &k) + factor(1, 0) * g0;
         for i in 1..S {
-            let m = p.waits_for[i];
-            // c_i S θ' + S² Σ_{j<n} a_ij w_j g_j.
-            let early = |n: usize| R::from_f64(p.c[i]) * s * rate + s2 * dot(&p.a[i][..n], &k[..n]);
-            let d = if i == 1 {
-                early(0) + factor(1, 0) * prev
-            } else if m == i - 1 {
-                (early(i - 2) + factor(i, i - 2) * prev2) + factor(i, i - 1) * prev
-            } else if m == i - 2 {
-                early(i - 2) + factor(i, i - 2) * prev2
+            // Stage i + 1's offset as e + f g_i when it waits for g_i.
+            let n = i + 1;
+            let waits = n < S && p.waits_for[n] == i;
+            let next = if waits {
+                (factor(n, i), early(n, i - 1, &k) + factor(n, i - 1) * prev)
             } else {
-                early(i)
+                (R::ZERO, R::ZERO)
             };
-            let raw = g(i, theta + d, d);
+            let (raw, d_next) = g(i, theta + d, d, next);
             k[i] = R::from_f64(weight(i)) * raw;
-            (prev, prev2) = (raw, prev);
+            prev = raw;
+            if n < S {
+                d = if waits {
+                    d_next
+                } else {
+                    let m = p.waits_for[n];
+                    early(n, m + 1, &k)
+                };
+            }
         }
         let (ph, vh) = (dot(&p.bbar, &k), dot(&p.b, &k));
         let (pl, vl) = (dot(&p.bbar_low, &k), dot(&p.b_low, &k));
