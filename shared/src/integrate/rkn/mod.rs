@@ -211,7 +211,8 @@ impl<const S: usize> Damped<S> {
         let p = self.pair;
         let s = R::from_f64(self.s);
         let s2 = R::from_f64(self.s * self.s);
-        let weight = |i: usize| if p.c[i] == 0.0 { 1.0 } else { self.weight[i] };
+        // c_0 = 0 (an explicit pair's first stage is its start): w_0 = 1.
+        let weight = |i: usize| if i == 0 { 1.0 } else { self.weight[i] };
         // S² a_ij w_j, the factor of g_j in stage i's offset.
         let factor = |i: usize, j: usize| s2 * R::from_f64(p.a[i][j] * weight(j));
         // k[j] = w_j g_j: the transformed acceleration at stage j.
@@ -360,6 +361,13 @@ mod tests {
                 assert!(order > 12.3, "c = {c}: {a:e} → {b:e}, order {order}");
             }
         }
+    }
+
+    #[test]
+    fn every_pair_starts_at_the_step_start() {
+        // Damped::step_from takes w_0 = 1 without looking: c_0 = 0 makes it so.
+        assert_eq!(RKN86.c[0], 0.0);
+        assert_eq!(RKN1210.c[0], 0.0);
     }
 
     #[test]
