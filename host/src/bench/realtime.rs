@@ -72,10 +72,12 @@ fn end(s: &Scene, method: Method, controller: Controller) -> Result<(f64, f64)> 
     Ok(r.end.angle_rate())
 }
 
-/// Tolerances tried, loosest first.
-const LADDER: [f64; 22] = [
-    1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5, 5e-6, 2e-6, 1e-6, 5e-7, 2e-7, 1e-7,
-    5e-8, 2e-8, 1e-8, 5e-9, 2e-9, 1e-9,
+/// Tolerances tried, loosest first: 1, 1.5, 2, 3, 5 and 7 per decade, fine enough that the
+/// cheapest setting reaching [`TARGET`] is found to within a step of about 1.5 in tolerance.
+const LADDER: [f64; 43] = [
+    1e-2, 7e-3, 5e-3, 3e-3, 2e-3, 1.5e-3, 1e-3, 7e-4, 5e-4, 3e-4, 2e-4, 1.5e-4, 1e-4, 7e-5, 5e-5,
+    3e-5, 2e-5, 1.5e-5, 1e-5, 7e-6, 5e-6, 3e-6, 2e-6, 1.5e-6, 1e-6, 7e-7, 5e-7, 3e-7, 2e-7, 1.5e-7,
+    1e-7, 7e-8, 5e-8, 3e-8, 2e-8, 1.5e-8, 1e-8, 7e-9, 5e-9, 3e-9, 2e-9, 1.5e-9, 1e-9,
 ];
 
 /// What is measured: (model, method, controller).

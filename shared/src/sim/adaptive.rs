@@ -105,6 +105,17 @@ impl<R: Real, D: DriveSignal<R>> Accel<R> for Slow<'_, R, D> {
             }
         }
     }
+
+    #[inline(always)]
+    fn accel_then(&self, base: &SlowBase<R>, t: f64, phi: R, d: R, next: (R, R)) -> (R, R) {
+        match &base.series {
+            Some(series) if d.abs().to_f64() <= slow_series::REACH => series.at_then(d, next),
+            _ => {
+                let g = self.accel(base, t, phi, d);
+                (g, next.1 + next.0 * g)
+            }
+        }
+    }
 }
 
 /// The full equation's conservative part (gravity and drive) seen by the adaptive run.

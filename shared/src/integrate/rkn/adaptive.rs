@@ -33,6 +33,13 @@ pub trait Accel<R: Real> {
     /// g at (t, θ), inside the step whose start gave `base`; `offset` = θ − θ0 (formed without
     /// the rounding of that difference).
     fn accel(&self, base: &Self::Base, t: f64, theta: R, offset: R) -> R;
+    /// g at (t, θ) and e + f g: the next stage's offset, which an implementation may form
+    /// without waiting for g's last operation (the stages' chain runs through it).
+    #[inline(always)]
+    fn accel_then(&self, base: &Self::Base, t: f64, theta: R, offset: R, (f, e): (R, R)) -> (R, R) {
+        let g = self.accel(base, t, theta, offset);
+        (g, e + f * g)
+    }
 }
 
 /// The settings of an adaptive RKN 8(6) run.
@@ -156,7 +163,10 @@ impl AdaptiveRkn {
         if t1.is_nan() || t1 <= t0 || !y.0.is_finite() || !y.1.is_finite() {
             return Ok(Solution { t, y, stats });
         }
-        let mut g0 = sys.accel(&sys.base(t, y.0), t, y.0, R::ZERO);
+        // The start's base serves every attempt from it; a pair that is not first-same-as-last
+        // builds the next start's base for its g there.
+        let mut base = sys.base(t, y.0);
+        let mut g0 = sys.accel(&base, t, y.0, R::ZERO);
         stats.rhs_evals += 1;
         let h_max = self.h_max.min(t1 - t0);
         let mut h = self
@@ -167,7 +177,17 @@ impl AdaptiveRkn {
         let scaled = |e: R, a: R, b: R| {
             e.to_f64().abs() / (atol + rtol * a.to_f64().abs().max(b.to_f64().abs()))
         };
-        let (mut err_prev, mut after_reject, mut attempts) = (1e-4f64, false, 0u64);
+        // SAFETY err_prev^β, known a step ahead of the error it multiplies. The growth is
+        // formed as a product (err^(0.2β − 1/(q+1)) by pow_rough): divisions would sit on the
+        // path from one step's error to the next step's first stage.
+        let memory = |err_prev: f64| {
+            if self.beta == 0.0 {
+                SAFETY
+            } else {
+                SAFETY * math::pow_rough(err_prev, self.beta)
+            }
+        };
+        let (mut safe_memory, mut after_reject, mut attempts) = (memory(1e-4), false, 0u64);
         loop {
             if attempts >= self.max_steps {
                 return Err(IntegrateError::TooManySteps { t });
@@ -180,28 +200,36 @@ impl AdaptiveRkn {
             let t_new = if last { t1 } else { t + h };
             h = t_new - t;
             let m = Damped::of(pair, h, c, !sys.autonomous());
-            let base = sys.base(t, y.0);
-            let out = m.step_from(y.0, y.1, g0, |i, th, d| {
-                sys.accel(&base, t + m.tau[i], th, d)
+            let out = m.step_from(y.0, y.1, g0, |i, th, d, next| {
+                sys.accel_then(&base, t + m.tau[i], th, d, next)
             });
             stats.rhs_evals += S as u64 - 1;
             let err = scaled(out.error.0, y.0, out.theta).max(scaled(out.error.1, y.1, out.rate));
             if !err.is_finite() || !out.theta.is_finite() || !out.rate.is_finite() {
                 return Err(IntegrateError::NonFinite { t });
             }
-            let fac_err = math::pow_rough(err, exponent - 0.2 * self.beta);
+            let grow_err = math::pow_rough(err, 0.2 * self.beta - exponent);
             if err > 1.0 {
-                h /= (fac_err / SAFETY).min(1.0 / FAC_MIN);
+                h *= (grow_err * SAFETY).max(FAC_MIN);
                 stats.rejected += 1;
                 after_reject = true;
                 continue;
             }
             stats.steps += 1;
+            // The next step's size first: every stage of that step waits for it.
+            let grow = (grow_err * safe_memory).clamp(FAC_MIN, FAC_MAX);
+            let mut h_new = (h * grow).min(h_max);
+            if after_reject {
+                h_new = h_new.min(h);
+            }
+            safe_memory = memory(err.max(1e-4));
+            after_reject = false;
+            base = sys.base(t_new, out.theta);
             let g1 = if pair.fsal {
                 out.g1
             } else {
                 stats.rhs_evals += 1;
-                sys.accel(&sys.base(t_new, out.theta), t_new, out.theta, R::ZERO)
+                sys.accel(&base, t_new, out.theta, R::ZERO)
             };
             let span = Span {
                 t0: t,
@@ -214,18 +242,6 @@ impl AdaptiveRkn {
             if last || stop {
                 return Ok(Solution { t, y, stats });
             }
-            let memory = if self.beta == 0.0 {
-                1.0
-            } else {
-                math::pow_rough(err_prev, self.beta)
-            };
-            let fac = (fac_err / memory / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-            let mut h_new = (h / fac).min(h_max);
-            if after_reject {
-                h_new = h_new.min(h);
-            }
-            err_prev = err.max(1e-4);
-            after_reject = false;
             h = h_new;
         }
     }

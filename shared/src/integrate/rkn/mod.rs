@@ -48,6 +48,24 @@ pub struct Pair<const S: usize> {
     pub orders: (u32, u32),
     /// The last stage is g at the step's end (first same as last).
     pub fsal: bool,
+    /// For each stage, the latest earlier stage its row uses: the one whose g it waits for.
+    pub waits_for: [usize; S],
+}
+
+/// The latest j < i with a_ij ≠ 0, for every row i (0 for the first two). A stage that skips
+/// its predecessor can start before that predecessor's g is known.
+const fn waits_for<const S: usize>(a: &[[f64; S]; S]) -> [usize; S] {
+    let mut out = [0; S];
+    let mut i = 1;
+    while i < S {
+        let mut j = i - 1;
+        while j > 0 && a[i][j] == 0.0 {
+            j -= 1;
+        }
+        out[i] = j;
+        i += 1;
+    }
+    out
 }
 
 /// Dormand, El-Mikkawy & Prince 8(6), nine stages, FSAL ([`tableau`]).
@@ -60,6 +78,7 @@ pub const RKN86: Pair<{ tableau::STAGES }> = Pair {
     b_low: tableau::B6,
     orders: (8, 6),
     fsal: true,
+    waits_for: waits_for(&tableau::A),
 };
 
 /// Dormand, El-Mikkawy & Prince 12(10), seventeen stages ([`tableau12`]).
@@ -72,6 +91,7 @@ pub const RKN1210: Pair<{ tableau12::STAGES }> = Pair {
     b_low: tableau12::B10,
     orders: (12, 10),
     fsal: false,
+    waits_for: waits_for(&tableau12::A),
 };
 
 /// Steps of one size H of a pair for a given damping c: the stage times and weights of the
@@ -117,12 +137,13 @@ impl<const S: usize> Damped<S> {
     /// Steps of `pair` of size `h` with damping `c` ≥ 0. Without `times` the stage times (one
     /// log1p each) are left out and [`Damped::tau`] is NaN: what an adaptive run of an
     /// autonomous equation, building a new step size every step, wants.
-    #[inline]
+    #[inline(always)]
     pub fn of(pair: &'static Pair<S>, h: f64, c: f64, times: bool) -> Self {
         let ch = c * h;
-        // S = (1 − e^(−cH))/c; τ(s) = −ln(1 − c s)/c; e^(−cH) = 1 − c S.
-        let expm1 = libm::expm1(-ch);
-        let s = if c > 0.0 { -expm1 / c } else { h };
+        // S = (1 − e^(−cH))/c; τ(s) = −ln(1 − c s)/c; e^(−cH) = 1 − c S. 1/c does not wait
+        // for the step size.
+        let expm1 = crate::math::expm1(-ch);
+        let s = if c > 0.0 { -expm1 * (1.0 / c) } else { h };
         let mut tau = [f64::NAN; S];
         let mut weight = [1.0; S];
         if c > 0.0 {
@@ -161,39 +182,68 @@ impl<const S: usize> Damped<S> {
         g0: R,
         mut g: impl FnMut(usize, R) -> R,
     ) -> RknStep<R> {
-        self.step_from(theta, rate, g0, |i, th, _| g(i, th))
+        self.step_from(theta, rate, g0, |i, th, _, (f, e)| {
+            let gi = g(i, th);
+            (gi, e + f * gi)
+        })
     }
 
     /// [`Damped::step`] with g also handed each stage's offset δ = θ_i − θ from the step's
-    /// start, computed without the rounding of θ_i − θ: `g(i, θ_i, δ_i)`.
+    /// start, computed without the rounding of θ_i − θ, and the next stage's offset in two
+    /// parts (f, e) such that δ_{i+1} = e + f g_i: `g(i, θ_i, δ_i, (f, e))` returns
+    /// (g_i, e + f g_i), and may form the second without waiting for the first ((0, 0) where
+    /// the next stage does not use g_i).
     ///
-    /// Every stage waits for the previous one's g, so the arithmetic between two evaluations is
-    /// the step's latency: the stage offset is formed as
-    /// δ_i = (c_i S θ' + S² Σ_{j<i−1} a_ij w_j g_j) + (S² a_{i,i−1} w_{i−1}) g_{i−1}, whose first
-    /// part and whose factor are ready before g_{i−1} is, so only one multiply and one add stand
-    /// between g_{i−1} and stage i (w_j: the damping weights).
+    /// Every stage waits for an earlier one's g, so the arithmetic between two evaluations is
+    /// the step's latency. The offset is
+    /// δ_{i+1} = ((c_{i+1} S θ' + S² Σ_{j<i−1} a_{i+1,j} w_j g_j) + S² a_{i+1,i−1} w_{i−1} g_{i−1}) + S² a_{i+1,i} w_i g_i
+    /// (w_j: the damping weights; w_0 = 1, known without a division): all but the last term
+    /// is ready before g_i is. A row that skips its predecessor ([`Pair::waits_for`]) does
+    /// not wait for it.
     #[inline(always)]
     pub fn step_from<R: Real>(
         &self,
         theta: R,
         rate: R,
         g0: R,
-        mut g: impl FnMut(usize, R, R) -> R,
+        mut g: impl FnMut(usize, R, R, (R, R)) -> (R, R),
     ) -> RknStep<R> {
         let p = self.pair;
         let s = R::from_f64(self.s);
         let s2 = R::from_f64(self.s * self.s);
-        // k[i] = w_i g_i: the transformed acceleration at stage i; raw: g_{i−1}.
+        // c_0 = 0 (an explicit pair's first stage is its start): w_0 = 1.
+        let weight = |i: usize| if i == 0 { 1.0 } else { self.weight[i] };
+        // S² a_ij w_j, the factor of g_j in stage i's offset.
+        let factor = |i: usize, j: usize| s2 * R::from_f64(p.a[i][j] * weight(j));
+        // k[j] = w_j g_j: the transformed acceleration at stage j.
         let mut k = [R::ZERO; S];
-        k[0] = R::from_f64(self.weight[0]) * g0;
-        let mut raw = g0;
+        k[0] = R::from_f64(weight(0)) * g0;
+        // c_i S θ' + S² Σ_{j<n} a_ij w_j g_j.
+        let early = |i: usize, n: usize, k: &[R; S]| {
+            R::from_f64(p.c[i]) * s * rate + s2 * dot(&p.a[i][..n], &k[..n])
+        };
+        let mut prev = g0;
+        let mut d = early(1, 0, &k) + factor(1, 0) * g0;
         for i in 1..S {
-            let acc = dot(&p.a[i][..i - 1], &k[..i - 1]);
-            let ready = R::from_f64(p.c[i]) * s * rate + s2 * acc;
-            let last = R::from_f64(self.s * self.s * p.a[i][i - 1] * self.weight[i - 1]);
-            let d = ready + last * raw;
-            raw = g(i, theta + d, d);
-            k[i] = R::from_f64(self.weight[i]) * raw;
+            // Stage i + 1's offset as e + f g_i when it waits for g_i.
+            let n = i + 1;
+            let waits = n < S && p.waits_for[n] == i;
+            let next = if waits {
+                (factor(n, i), early(n, i - 1, &k) + factor(n, i - 1) * prev)
+            } else {
+                (R::ZERO, R::ZERO)
+            };
+            let (raw, d_next) = g(i, theta + d, d, next);
+            k[i] = R::from_f64(weight(i)) * raw;
+            prev = raw;
+            if n < S {
+                d = if waits {
+                    d_next
+                } else {
+                    let m = p.waits_for[n];
+                    early(n, m + 1, &k)
+                };
+            }
         }
         let (ph, vh) = (dot(&p.bbar, &k), dot(&p.b, &k));
         let (pl, vl) = (dot(&p.bbar_low, &k), dot(&p.b_low, &k));
@@ -201,7 +251,7 @@ impl<const S: usize> Damped<S> {
         RknStep {
             theta: theta + s * rate + s2 * ph,
             rate: decay * (rate + s * vh),
-            g1: if p.fsal { raw } else { R::from_f64(f64::NAN) },
+            g1: if p.fsal { prev } else { R::from_f64(f64::NAN) },
             error: (s2 * (ph - pl), decay * s * (vh - vl)),
         }
     }
@@ -311,6 +361,13 @@ mod tests {
                 assert!(order > 12.3, "c = {c}: {a:e} → {b:e}, order {order}");
             }
         }
+    }
+
+    #[test]
+    fn every_pair_starts_at_the_step_start() {
+        // Damped::step_from takes w_0 = 1 without looking: c_0 = 0 makes it so.
+        assert_eq!(RKN86.c[0], 0.0);
+        assert_eq!(RKN1210.c[0], 0.0);
     }
 
     #[test]
