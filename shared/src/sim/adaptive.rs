@@ -214,22 +214,62 @@ mod tests {
         use crate::sim::signal::Steady;
         let (w0sq, r) = (73.6, 3.3);
         let angle = DriveAngle::from_deg(135.0).unwrap();
-        let eom =
-            AveragedEom::<f64, _, _>::new(w0sq, r, angle, Steady::new(0.0445, 330.0), NoExtra);
-        let slow = Slow(&eom);
-        assert!(slow.autonomous());
-        for phi0 in [-2.5, 0.3, 2.08, 3.0] {
-            let base = slow.base(0.0, phi0);
-            for i in -40..=40 {
-                let d = 0.02 * f64::from(i);
-                let (s, c) = libm::sincos(phi0 + d);
-                let want = eom.conservative_sc(0.0, s, c);
-                let got = slow.accel(&base, 0.0, phi0 + d, d);
-                assert!(
-                    (got - want).abs() < 1e-14 * w0sq * r,
-                    "φ0 {phi0} d {d}: {got} vs {want}"
-                );
+        // Without and with a slider-crank's push (κ = 0.05, twice the demo rod's on a 60 mm
+        // connecting rod).
+        for kappa in [0.0, 0.05] {
+            let eom =
+                AveragedEom::<f64, _, _>::new(w0sq, r, angle, Steady::new(0.0445, 330.0), NoExtra)
+                    .with_push(kappa);
+            let slow = Slow(&eom);
+            assert!(slow.autonomous());
+            for phi0 in [-2.5, 0.3, 2.08, 3.0] {
+                let base = slow.base(0.0, phi0);
+                for i in -40..=40 {
+                    let d = 0.02 * f64::from(i);
+                    let (s, c) = libm::sincos(phi0 + d);
+                    let want = eom.conservative_sc(0.0, s, c);
+                    let got = slow.accel(&base, 0.0, phi0 + d, d);
+                    assert!(
+                        (got - want).abs() < 1e-14 * w0sq * r,
+                        "κ {kappa} φ0 {phi0} d {d}: {got} vs {want}"
+                    );
+                }
             }
+        }
+    }
+
+    #[test]
+    fn the_averaged_force_with_a_push_is_the_slider_crank_balance() {
+        // AveragedEom's closed form with the push against model::slider_crank's slow torque
+        // (its other form, sin u (cos²u − ½ sin²u)), both ×ω0²: the demo rod on a 12.7 mm crank
+        // and a 60 mm rod at first-harmonic R = 1.75, θd = 90°, to rounding.
+        use crate::model::slider_crank::{slow_torque, SliderCrank};
+        use crate::model::DriveAngle;
+        use crate::sim::signal::Steady;
+        let crank = SliderCrank {
+            amplitude: 0.0127,
+            rod: 0.06,
+            ell: 0.25 * 2.0 / 3.0,
+        };
+        let (w0sq, r1) = (9.81 / crank.ell, 1.75);
+        let angle = DriveAngle::from_deg(90.0).unwrap();
+        let eom = AveragedEom::<f64, _, _>::new(
+            w0sq,
+            r1 * crank.strength_gain(),
+            angle,
+            Steady::new(0.0, 1.0),
+            NoExtra,
+        )
+        .with_push(r1 * crank.push_per_r());
+        for i in -31..=31 {
+            let phi = 0.1 * f64::from(i);
+            let (s, c) = libm::sincos(phi);
+            let want = w0sq * slow_torque(phi, angle.rad(), r1, Some(&crank));
+            let got = eom.conservative_sc(0.0, s, c);
+            assert!(
+                (got - want).abs() < 1e-13 * w0sq,
+                "φ {phi}: {got} vs {want}"
+            );
         }
     }
 }

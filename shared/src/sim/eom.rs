@@ -135,6 +135,8 @@ pub struct AveragedEom<R, D, X> {
     omega0_sq: R,
     /// ω0² R_eff / 2.
     half_r: R,
+    /// ω0² κ/8: the slider-crank's third-order push (physics §5.1); 0 without a connecting rod.
+    push: R,
     sin_d: R,
     cos_d: R,
     drive: D,
@@ -146,6 +148,7 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
         Self {
             omega0_sq: R::from_f64(omega0_sq),
             half_r: R::from_f64(0.5 * r_eff * omega0_sq),
+            push: R::ZERO,
             sin_d: R::from_f64(angle.sin()),
             cos_d: R::from_f64(angle.cos()),
             drive,
@@ -155,6 +158,15 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
 }
 
 impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
+    /// With a slider-crank's third-order push of strength κ = 3 R B/ℓ (physics §5.1,
+    /// `model::slider_crank`): the term −ω0² κ sin u (cos²u − ½ sin²u), u = φ − θd.
+    pub fn with_push(self, kappa: f64) -> Self {
+        Self {
+            push: R::from_f64(kappa * self.omega0_sq.to_f64() / 8.0),
+            ..self
+        }
+    }
+
     pub fn drive(&self) -> &D {
         &self.drive
     }
@@ -165,8 +177,13 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
     pub(super) fn series(&self, t: f64, s: R, c: R) -> SlowSeries<R> {
         let s_rel = s * self.cos_d - c * self.sin_d;
         let c_rel = c * self.cos_d + s * self.sin_d;
-        let h_sigma = self.half_r * self.drive.strength(t);
-        SlowSeries::about(self.omega0_sq, h_sigma, (s, c), (s_rel, c_rel))
+        let sigma = self.drive.strength(t);
+        let series = SlowSeries::about(self.omega0_sq, self.half_r * sigma, (s, c), (s_rel, c_rel));
+        if self.push == R::ZERO {
+            series
+        } else {
+            series.with_push(self.push * sigma, (s_rel, c_rel))
+        }
     }
 
     /// Gravity and the averaged drive force at t, given (sin φ, cos φ).
@@ -175,8 +192,15 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
         let s_rel = s * self.cos_d - c * self.sin_d;
         let c_rel = c * self.cos_d + s * self.sin_d;
         let two = R::ONE + R::ONE;
+        let sigma = self.drive.strength(t);
         // sin 2(φ − θd) = 2 sin(φ − θd) cos(φ − θd)
-        -self.omega0_sq * s - self.half_r * self.drive.strength(t) * two * s_rel * c_rel
+        let g = -self.omega0_sq * s - self.half_r * sigma * two * s_rel * c_rel;
+        if self.push == R::ZERO {
+            return g;
+        }
+        // K (sin u − 3 sin 3u) = −8K sin u (cos²u − ½ sin²u)
+        let (s2, c2) = (s_rel * s_rel, c_rel * c_rel);
+        g - R::from_f64(8.0) * self.push * sigma * s_rel * (c2 - s2 / two)
     }
 }
 
