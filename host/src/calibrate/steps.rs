@@ -9,7 +9,6 @@ use kapitza_core::calib::{current, direction, plumb, ringdown, servo_fit, stroke
 use kapitza_core::link::convert::from_q16;
 use kapitza_core::link::message::Mode;
 use kapitza_core::math;
-use kapitza_core::model::slider_crank::SliderCrank;
 use kapitza_core::model::Geometry;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::Angle;
@@ -442,12 +441,13 @@ impl<'a> Calibrator<'a> {
         };
         let first = measure(math::to_rad(STROKE_DEG))?;
         let r_true = first * first * omega * omega / (2.0 * g * ell);
+        // The configuration's slider-crank with the stroke measured here.
         let crank = |amplitude: f64| {
-            (self.cfg.connecting_rod > 0.0).then_some(SliderCrank {
+            RigConfig {
                 amplitude,
-                rod: self.cfg.connecting_rod,
-                ell,
-            })
+                ..self.cfg
+            }
+            .slider_crank()
         };
         let theta_d = plumb::drive_angle(phi0, r_true, crank(first).as_ref())
             .map_err(|e| refused(Step::Stroke, e))?;

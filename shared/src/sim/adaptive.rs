@@ -211,16 +211,11 @@ mod tests {
         // sides of the series' reach (1/2 rad: beyond it, the angle-addition path): within
         // 1e-14 of ω0² R (a few ulps of the terms' size).
         use crate::model::DriveAngle;
-        use crate::sim::signal::Steady;
+        use crate::sim::signal::{Schedule, Shaped, Steady};
         let (w0sq, r) = (73.6, 3.3);
         let angle = DriveAngle::from_deg(135.0).unwrap();
-        // Without and with a slider-crank's push (κ = 0.05, twice the demo rod's on a 60 mm
-        // connecting rod).
-        for kappa in [0.0, 0.05] {
-            let eom =
-                AveragedEom::<f64, _, _>::new(w0sq, r, angle, Steady::new(0.0445, 330.0), NoExtra)
-                    .with_push(kappa);
-            let slow = Slow(&eom);
+        fn check<D: DriveSignal<f64>>(eom: &AveragedEom<f64, D, NoExtra>, w0sq: f64, r: f64) {
+            let slow = Slow(eom);
             assert!(slow.autonomous());
             for phi0 in [-2.5, 0.3, 2.08, 3.0] {
                 let base = slow.base(0.0, phi0);
@@ -231,11 +226,22 @@ mod tests {
                     let got = slow.accel(&base, 0.0, phi0 + d, d);
                     assert!(
                         (got - want).abs() < 1e-14 * w0sq * r,
-                        "κ {kappa} φ0 {phi0} d {d}: {got} vs {want}"
+                        "φ0 {phi0} d {d}: {got} vs {want}"
                     );
                 }
             }
         }
+        let steady = Steady::new(0.0445, 330.0);
+        check(&AveragedEom::new(w0sq, r, angle, steady, NoExtra), w0sq, r);
+        // With a slider-crank on a 30 mm connecting rod (a2/ℓ = A²/(4bℓ) = 0.0445 · 0.0089/0.12):
+        // the push's harmonics in the series too.
+        let schedule = Schedule {
+            omega: 330.0,
+            ramp: None,
+            lag: None,
+        };
+        let shaped = Shaped::new(0.0445, 0.0445 * 0.0089 / 0.12, schedule);
+        check(&AveragedEom::new(w0sq, r, angle, shaped, NoExtra), w0sq, r);
     }
 
     #[test]
@@ -243,24 +249,33 @@ mod tests {
         // AveragedEom's closed form with the push against model::slider_crank's slow torque
         // (its other form, sin u (cos²u − ½ sin²u)), both ×ω0²: the demo rod on a 12.7 mm crank
         // and a 60 mm rod at first-harmonic R = 1.75, θd = 90°, to rounding.
+        // The push comes from the drive signal's harmonics (a1/ℓ, a2/ℓ, W), the balance's from
+        // the crank's dimensions and R: two routes to ω0²κ/8.
         use crate::model::slider_crank::{slow_torque, SliderCrank};
         use crate::model::DriveAngle;
-        use crate::sim::signal::Steady;
+        use crate::sim::signal::{Schedule, Shaped};
         let crank = SliderCrank {
             amplitude: 0.0127,
             rod: 0.06,
             ell: 0.25 * 2.0 / 3.0,
         };
         let (w0sq, r1) = (9.81 / crank.ell, 1.75);
+        let schedule = Schedule {
+            // R = A²W²/(2gℓ)
+            omega: (2.0 * 9.81 * crank.ell * r1).sqrt() / crank.amplitude,
+            ramp: None,
+            lag: None,
+        };
+        let a1 = crank.amplitude / crank.ell;
+        let a2 = crank.amplitude * crank.amplitude / (4.0 * crank.rod) / crank.ell;
         let angle = DriveAngle::from_deg(90.0).unwrap();
-        let eom = AveragedEom::<f64, _, _>::new(
+        let eom = AveragedEom::new(
             w0sq,
             r1 * crank.strength_gain(),
             angle,
-            Steady::new(0.0, 1.0),
+            Shaped::new(a1, a2, schedule),
             NoExtra,
-        )
-        .with_push(r1 * crank.push_per_r());
+        );
         for i in -31..=31 {
             let phi = 0.1 * f64::from(i);
             let (s, c) = libm::sincos(phi);

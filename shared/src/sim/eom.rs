@@ -135,8 +135,6 @@ pub struct AveragedEom<R, D, X> {
     omega0_sq: R,
     /// ω0² R_eff / 2.
     half_r: R,
-    /// ω0² κ/8: the slider-crank's third-order push (physics §5.1); 0 without a connecting rod.
-    push: R,
     sin_d: R,
     cos_d: R,
     drive: D,
@@ -148,7 +146,6 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
         Self {
             omega0_sq: R::from_f64(omega0_sq),
             half_r: R::from_f64(0.5 * r_eff * omega0_sq),
-            push: R::ZERO,
             sin_d: R::from_f64(angle.sin()),
             cos_d: R::from_f64(angle.cos()),
             drive,
@@ -158,15 +155,6 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
 }
 
 impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
-    /// With a slider-crank's third-order push of strength κ = 3 R B/ℓ (physics §5.1,
-    /// `model::slider_crank`): the term −ω0² κ sin u (cos²u − ½ sin²u), u = φ − θd.
-    pub fn with_push(self, kappa: f64) -> Self {
-        Self {
-            push: R::from_f64(kappa * self.omega0_sq.to_f64() / 8.0),
-            ..self
-        }
-    }
-
     pub fn drive(&self) -> &D {
         &self.drive
     }
@@ -179,10 +167,11 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
         let c_rel = c * self.cos_d + s * self.sin_d;
         let sigma = self.drive.strength(t);
         let series = SlowSeries::about(self.omega0_sq, self.half_r * sigma, (s, c), (s_rel, c_rel));
-        if self.push == R::ZERO {
+        let push = self.drive.push();
+        if push == R::ZERO {
             series
         } else {
-            series.with_push(self.push * sigma, (s_rel, c_rel))
+            series.with_push(push * sigma, (s_rel, c_rel))
         }
     }
 
@@ -195,12 +184,14 @@ impl<R: Real, D: DriveSignal<R>, X: Extra<R>> AveragedEom<R, D, X> {
         let sigma = self.drive.strength(t);
         // sin 2(φ − θd) = 2 sin(φ − θd) cos(φ − θd)
         let g = -self.omega0_sq * s - self.half_r * sigma * two * s_rel * c_rel;
-        if self.push == R::ZERO {
+        let push = self.drive.push();
+        if push == R::ZERO {
             return g;
         }
-        // K (sin u − 3 sin 3u) = −8K sin u (cos²u − ½ sin²u)
+        // The slider-crank's push K (sin u − 3 sin 3u) = −8K sin u (cos²u − ½ sin²u),
+        // u = φ − θd (physics §5.1).
         let (s2, c2) = (s_rel * s_rel, c_rel * c_rel);
-        g - R::from_f64(8.0) * self.push * sigma * s_rel * (c2 - s2 / two)
+        g - R::from_f64(8.0) * push * sigma * s_rel * (c2 - s2 / two)
     }
 }
 

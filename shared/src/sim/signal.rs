@@ -30,6 +30,10 @@ pub trait DriveSignal<R: Real>: Copy {
     fn strobe_time(&self, k: u64) -> f64;
     /// Whether [`DriveSignal::strength`] is the same at every t (no ramp, no lag).
     fn constant_strength(&self) -> bool;
+    /// The averaged model's third-order push of the two harmonics at the set point, ω0²κ/8 =
+    /// (3/16) (a1/ℓ)² (a2/ℓ) W² (physics §5.1; it scales with the strength as R does); zero
+    /// for a single harmonic, and a constant the compiler sees for [`Steady`].
+    fn push(&self) -> R;
 }
 
 /// A steady sinusoid A cos(Wt): no ramp, no lag, no second harmonic.
@@ -57,6 +61,10 @@ impl<R: Real> DriveSignal<R> for Steady<R> {
     #[inline]
     fn strength(&self, _t: f64) -> R {
         R::ONE
+    }
+    #[inline(always)]
+    fn push(&self) -> R {
+        R::ZERO
     }
     fn constant_strength(&self) -> bool {
         true
@@ -219,6 +227,10 @@ impl<R: Real> DriveSignal<R> for Shaped<R> {
     }
     fn strobe_time(&self, k: u64) -> f64 {
         self.schedule.time_of_phase(k as f64 * math::TAU)
+    }
+    fn push(&self) -> R {
+        let w = self.schedule.omega;
+        R::from_f64(3.0 / 16.0 * w * w) * self.a1 * self.a1 * self.a2
     }
 }
 

@@ -14,16 +14,17 @@
 //!   and with K: + (−1)^m/n! Kσ (S1 − 3^(n+1) S3)  (n = 2m; C1, C3 for n = 2m + 1),
 //!   S1, C1 = sin, cos (φ0 − θd), S3, C3 = sin, cos 3(φ0 − θd)
 //! ```
-//! (sin u cos²u − ½ sin³u = (3 sin 3u − sin u)/8.) The push's harmonic 3u is left out at
-//! (3d)ⁿ/n! of Kσ: 4e-18 of it for twelve terms at |d| ≤ 1/16, 1.4e-15 for twenty at 1/2, with
-//! K below a few per cent of H on any rig the averaged model is valid for.
 //! Twenty terms serve |d| ≤ 1/2, sixteen |d| ≤ 1/4, twelve |d| ≤ 1/16: the first terms left
 //! out are at most (2d)²⁰/20! < 5e-19, (2d)¹⁶/16! < 8e-19 and (2d)¹²/12! < 4e-20 of 2Hσ (and
-//! of ω0²), so the series is g to rounding. A step computes the coefficients once (one sin/cos of φ0); a stage then costs one
-//! polynomial in d evaluated in Estrin's scheme, whose dependency chain is four or five
-//! multiply–adds deep instead of the sin, cos and products of the closed form (every stage
-//! waits for the previous one's g, so that chain is the cost). σ must be constant over the
-//! step (a drive of constant strength).
+//! of ω0²), so the series is g to rounding. The push (sin u cos²u − ½ sin³u = (3 sin 3u −
+//! sin u)/8) leaves out (3d)ⁿ/n! of 3Kσ: 4e-18 of it for twelve terms at |d| ≤ 1/16, 1.4e-15
+//! for twenty at 1/2, with K a few per cent of H at most.
+//!
+//! A step computes the coefficients once (one sin/cos of φ0); a stage then costs one polynomial
+//! in d evaluated in Estrin's scheme, whose dependency chain is four or five multiply–adds deep
+//! instead of the sin, cos and products of the closed form (every stage waits for the previous
+//! one's g, so that chain is the cost). σ must be constant over the step (a drive of constant
+//! strength).
 
 use crate::Real;
 
@@ -36,8 +37,8 @@ const NEAR: f64 = 0.25;
 /// Up to this |d| the first twelve suffice: most stages of a run near rest.
 const CLOSE: f64 = 1.0 / 16.0;
 
-/// (−1)^m/n! and (−1)^m 2^n/n! for n = 2m and 2m + 1 < [`TERMS`]: g's coefficients per unit of
-/// the sin φ0 (cos φ0) part and of the sin 2(φ0 − θd) (cos 2(φ0 − θd)) part.
+/// (−1)^m kⁿ/n! for k = 1, 2, 3 and n = 2m, 2m + 1 < [`TERMS`]: g's coefficients per unit of
+/// the sin (cos) of φ0 or u0, of 2u0 and of 3u0 (u0 = φ0 − θd).
 const fn tables() -> [[f64; TERMS]; 3] {
     let mut t = [[0.0; TERMS]; 3];
     let (mut inv_fact, mut two_n, mut three_n) = (1.0, 1.0, 1.0);
@@ -55,7 +56,6 @@ const fn tables() -> [[f64; TERMS]; 3] {
     t
 }
 
-/// Per unit of the sin/cos of φ0 (and of u0), of 2u0, of 3u0: (−1)^m kⁿ/n! for k = 1, 2, 3.
 const TABLES: [[f64; TERMS]; 3] = tables();
 
 /// g(φ0 + d) = Σ G_n dⁿ about one step's start.

@@ -180,6 +180,9 @@ mod tests {
         fn strobe_time(&self, k: u64) -> f64 {
             k as f64 * math::TAU / self.omega
         }
+        fn push(&self) -> f64 {
+            0.0
+        }
     }
 
     /// Period means of θ (trapezoid rule on RK4 at 256 steps per drive period) over `periods`

@@ -177,7 +177,7 @@ impl AdaptiveRkn {
         let scaled = |e: R, a: R, b: R| {
             e.to_f64().abs() / (atol + rtol * a.to_f64().abs().max(b.to_f64().abs()))
         };
-        // SAFETY err_prev^β, known a step ahead of the error it multiplies. The growth is
+        // The safety factor times err_prev^β, known a step ahead of the error it multiplies. The growth is
         // formed as a product (err^(0.2β − 1/(q+1)) by pow_rough): divisions would sit on the
         // path from one step's error to the next step's first stage.
         let memory = |err_prev: f64| {

@@ -49,10 +49,8 @@ pub(super) fn finish<R: Real, D: DriveSignal<R>, Rec: Recorder>(
         window: ctx.classify.then(|| window.insert(Strobes::default())),
     };
     let full = || FullEom::<R, D, NoExtra>::new(p.omega0 * p.omega0, angle, sig, NoExtra);
-    let averaged = || {
-        AveragedEom::<R, D, _>::new(p.omega0 * p.omega0, plan.r_effective, angle, sig, NoExtra)
-            .with_push(plan.push)
-    };
+    let averaged =
+        || AveragedEom::<R, D, _>::new(p.omega0 * p.omega0, plan.r_effective, angle, sig, NoExtra);
     let out = match (coulomb, ctx.method) {
         (Some(mu), _) => friction::run(full(), R::from_f64(p.c), mu, ctx, rec)?,
         (None, Method::Rkn86 { rtol, atol }) => match plan.decision.fidelity {
@@ -148,8 +146,8 @@ fn with_equation<R: Real, D: DriveSignal<R>, J: Job<R>>(
     match plan.decision.fidelity {
         Fidelity::Full => with_extras!(|x| FullEom::<R, D, _>::new(w0sq, angle, sig, x)),
         Fidelity::Averaged => {
-            let (r_eff, push) = (plan.r_effective, plan.push);
-            with_extras!(|x| AveragedEom::<R, D, _>::new(w0sq, r_eff, angle, sig, x).with_push(push))
+            let r_eff = plan.r_effective;
+            with_extras!(|x| AveragedEom::<R, D, _>::new(w0sq, r_eff, angle, sig, x))
         }
         Fidelity::Linearised => {
             let inverted = fidelity::linearised_centre(&plan.scene);

@@ -71,9 +71,6 @@ pub struct PlannedRun {
     pub a2: f64,
     /// R of the averaged model: R (1 + A²/(4b²)) with a slider-crank of rod length b.
     pub r_effective: f64,
-    /// The slider-crank's third-order push in the averaged model, κ = 3 R a2 (physics §5.1);
-    /// 0 without one.
-    pub push: f64,
     /// Whether the drive signal is shaped (ramp, actuator lag, slider-crank) or the steady sinusoid.
     pub shaped: bool,
     /// The averaged model's fast part, to read the full state back from the slow one.
@@ -137,7 +134,6 @@ impl PlannedRun {
             a1: p.amplitude / p.ell,
             a2,
             r_effective: averaged_r(scene, &p),
-            push: 3.0 * p.r * a2,
             shaped: shaped(scene),
             wobble,
             ctx,
