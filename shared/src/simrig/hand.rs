@@ -1,14 +1,18 @@
 //! A simulated lab hand: what a person does at `kapitza calibrate`'s prompt "hold the pendulum
-//! about 20° counter-clockwise and let go", so a simulated rig can be calibrated unattended.
+//! still about 20° counter-clockwise and let go", so a simulated rig can be calibrated
+//! unattended.
 //!
 //! ```text
 //! armed (the rig entered bring-up mode with the motor off):
-//!   lift  θ: θ_start → θ_start + release, smoothly (half a cosine) over LIFT_S
-//!   hold  LIFT_S … LIFT_S + HOLD_S at θ_start + release (the pendulum at rest in the hand)
+//!   grip  wherever the pendulum is, swinging or not (θ_start)
+//!   lift  θ: θ_start → release (counter-clockwise of hanging, the nearest turn), smoothly
+//!         (half a cosine) over LIFT_S
+//!   hold  LIFT_S … LIFT_S + HOLD_S at release (the pendulum at rest in the hand)
 //!   let go; nothing until armed again
 //! ```
-//! The hand moves the true angle, so the sensor sees it through its own zero and direction,
-//! as it would a person's hand.
+//! Like a person, it lets go from the angle it was asked for, not from wherever a swing left
+//! the pendulum: every ring-down then starts alike. The hand moves the true angle, so the
+//! sensor sees it through its own zero and direction, as it would a person's hand.
 
 use crate::math;
 
@@ -19,7 +23,7 @@ pub const HOLD_S: f64 = 1.0;
 /// The hand's state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hand {
-    /// How far it lifts the pendulum (rad, counter-clockwise positive).
+    /// The angle it lets go from (rad from hanging, counter-clockwise positive).
     pub release: f64,
     /// Since when it holds, and from which angle (rad); `None`: hands off.
     grip: Option<(f64, f64)>,
@@ -50,7 +54,7 @@ impl Hand {
             return None;
         }
         let lift = (1.0 - math::cos(math::PI * (dt / LIFT_S).min(1.0))) / 2.0;
-        Some(from + self.release * lift)
+        Some(from + math::wrap_pi(self.release - from) * lift)
     }
 }
 
@@ -63,12 +67,20 @@ mod tests {
         let mut h = Hand::new(0.35);
         assert_eq!(h.step(0.0, false, 0.01), None);
         assert_eq!(h.step(1.0, true, 0.01), Some(0.01));
-        assert!((h.step(1.25, true, 0.0).unwrap() - (0.01 + 0.175)).abs() < 1e-12);
-        assert_eq!(h.step(2.0, true, 0.0), Some(0.36));
+        // Half-way through the lift: half-way from the grip to 0.35.
+        assert!((h.step(1.25, true, 0.0).unwrap() - (0.01 + 0.17)).abs() < 1e-12);
+        assert!((h.step(2.0, true, 0.0).unwrap() - 0.35).abs() < 1e-12);
         assert_eq!(h.step(2.5, true, 0.3), None);
         // Still armed: no second lift until it is armed again.
         assert_eq!(h.step(5.0, true, 0.0), None);
         h.step(6.0, false, 0.0);
-        assert_eq!(h.step(7.0, true, 0.02), Some(0.02));
+        // Gripped mid-swing at −0.4: it still lets go from 0.35.
+        assert_eq!(h.step(7.0, true, -0.4), Some(-0.4));
+        assert!((h.step(8.0, true, 0.0).unwrap() - 0.35).abs() < 1e-12);
+        h.step(9.0, false, 0.0);
+        // A turn past hanging (θ = 2π − 0.1): it lifts to 2π + 0.35, not back through a turn.
+        let turn = crate::math::TAU - 0.1;
+        h.step(10.0, true, turn);
+        assert!((h.step(11.0, true, 0.0).unwrap() - (crate::math::TAU + 0.35)).abs() < 1e-12);
     }
 }

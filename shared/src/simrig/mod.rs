@@ -83,8 +83,9 @@ pub struct Params {
     pub sensor_line: Line,
     /// The pendulum's angle (rad) at power-up, at rest.
     pub theta0: f64,
-    /// A lab hand ([`hand`]): how far it lifts the pendulum counter-clockwise (rad) whenever
-    /// the rig enters bring-up mode with the motor off; `None`: nobody at the rig.
+    /// A lab hand ([`hand`]): the angle counter-clockwise of hanging (rad) it lifts the
+    /// pendulum to and lets go from whenever the rig enters bring-up mode with the motor off;
+    /// `None`: nobody at the rig.
     pub hand: Option<f64>,
     pub seed: u64,
 }
