@@ -107,6 +107,14 @@ impl<R: Real, D: DriveSignal<R>> Accel<R> for Slow<'_, R, D> {
     }
 
     #[inline(always)]
+    fn at_start(&self, base: &SlowBase<R>, t0: f64, phi0: R) -> R {
+        match &base.series {
+            Some(series) => series.at_zero(),
+            None => self.accel(base, t0, phi0, R::ZERO),
+        }
+    }
+
+    #[inline(always)]
     fn accel_then(&self, base: &SlowBase<R>, t: f64, phi: R, d: R, next: (R, R)) -> (R, R) {
         match &base.series {
             Some(series) if d.abs().to_f64() <= slow_series::REACH => series.at_then(d, next),

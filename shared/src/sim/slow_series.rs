@@ -107,6 +107,12 @@ impl<R: Real> SlowSeries<R> {
         self
     }
 
+    /// g(φ0) = G_0: the step's start, without the polynomial.
+    #[inline(always)]
+    pub fn at_zero(&self) -> R {
+        self.even[0]
+    }
+
     /// g(φ0 + d) for |d| ≤ [`REACH`].
     #[inline(always)]
     pub fn at(&self, d: R) -> R {
@@ -166,6 +172,8 @@ mod tests {
                     (phi0.sin(), phi0.cos()),
                     ((phi0 - td).sin(), (phi0 - td).cos()),
                 );
+                // The start is G_0 itself: the value an evaluation at d = 0 gives.
+                assert_eq!(ser.at_zero(), ser.at(0.0));
                 for i in -50..=50 {
                     let d = REACH * f64::from(i) / 50.0;
                     let err = (ser.at(d) - closed(phi0 + d, td)).abs();

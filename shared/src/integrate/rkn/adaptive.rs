@@ -33,6 +33,12 @@ pub trait Accel<R: Real> {
     /// g at (t, θ), inside the step whose start gave `base`; `offset` = θ − θ0 (formed without
     /// the rounding of that difference).
     fn accel(&self, base: &Self::Base, t: f64, theta: R, offset: R) -> R;
+    /// g at the step's start (t0, θ0) itself: `accel` at offset 0, which an implementation may
+    /// read off its base without evaluating anything.
+    #[inline(always)]
+    fn at_start(&self, base: &Self::Base, t0: f64, theta0: R) -> R {
+        self.accel(base, t0, theta0, R::ZERO)
+    }
     /// g at (t, θ) and e + f g: the next stage's offset, which an implementation may form
     /// without waiting for g's last operation (the stages' chain runs through it).
     #[inline(always)]
@@ -166,7 +172,7 @@ impl AdaptiveRkn {
         // The start's base serves every attempt from it; a pair that is not first-same-as-last
         // builds the next start's base for its g there.
         let mut base = sys.base(t, y.0);
-        let mut g0 = sys.accel(&base, t, y.0, R::ZERO);
+        let mut g0 = sys.at_start(&base, t, y.0);
         stats.rhs_evals += 1;
         let h_max = self.h_max.min(t1 - t0);
         let mut h = self
@@ -229,7 +235,7 @@ impl AdaptiveRkn {
                 out.g1
             } else {
                 stats.rhs_evals += 1;
-                sys.accel(&base, t_new, out.theta, R::ZERO)
+                sys.at_start(&base, t_new, out.theta)
             };
             let span = Span {
                 t0: t,
