@@ -164,9 +164,12 @@ fn an_owner_keeps_the_drive_and_relays_commands() {
     std::thread::sleep(Duration::from_millis(2500));
     let v = json(&kapitza(&["status", "--port", &port, "--json"]));
     assert_eq!(v["mode"], "running", "{v}");
-    // Ctrl-C on the owner stops the drive.
+    // Ctrl-C on the owner stops the drive, and the rig confirms it.
     let printed = owner.interrupt();
-    assert!(printed.contains("detached"), "{printed}");
+    assert!(
+        printed.contains("detached; the rig confirmed the stop"),
+        "{printed}"
+    );
     std::thread::sleep(Duration::from_millis(300));
     let v = json(&kapitza(&["status", "--port", &port, "--json"]));
     assert_ne!(v["mode"], "running", "{v}");

@@ -66,7 +66,14 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         }
         std::thread::sleep(Duration::from_millis(2));
     }
-    owner.shutdown();
-    writeln!(out, "detached; the drive was told to stop")?;
+    if owner.shutdown() {
+        writeln!(out, "detached; the rig confirmed the stop")?;
+    } else {
+        writeln!(
+            out,
+            "detached; the rig did not confirm the stop: it stops by itself once the line has \
+             been silent for its link timeout (link_timeout_ms, 1 s unless configured)"
+        )?;
+    }
     Ok(())
 }

@@ -87,13 +87,14 @@ impl OwnerFeed {
                         }
                     };
                     if ev_tx.send(ev).is_err() {
-                        owner.shutdown();
+                        // Nobody is watching any more: the rig's own timeout backs the stop.
+                        let _ = owner.shutdown();
                         return;
                     }
                 }
                 std::thread::sleep(Duration::from_millis(2));
             }
-            owner.shutdown();
+            let _ = owner.shutdown();
         });
         Self {
             events,

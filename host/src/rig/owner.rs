@@ -219,15 +219,22 @@ impl Owner {
         }
     }
 
-    /// Stops the drive (a soft stop) and lets go of the port and the socket.
-    pub fn shutdown(mut self) {
-        if let Some(s) = self.session.as_mut() {
-            let _ = s.client.stop();
-            let _ = s.client.stream_telemetry(0);
-        }
+    /// Stops the drive (a soft stop) and lets go of the port and the socket. Says whether the
+    /// rig confirmed the stop: without a line, or when it does not answer, it stops by itself
+    /// once the line has been silent for its link timeout.
+    pub fn shutdown(mut self) -> bool {
+        let stopped = match self.session.as_mut() {
+            Some(s) => {
+                let stopped = s.client.stop().is_ok();
+                let _ = s.client.stream_telemetry(0);
+                stopped
+            }
+            None => false,
+        };
         if let Some(p) = self.socket.take() {
             let _ = std::fs::remove_file(p);
         }
+        stopped
     }
 
     fn lost(&mut self, e: Error, events: &mut Vec<Event>) {
