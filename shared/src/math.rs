@@ -78,8 +78,8 @@ pub fn expm1(x: f64) -> f64 {
 /// ```text
 /// x = 2^e m, m in [√½, √2)          (the exponent bits, one higher past √2)
 /// log2 x = e + (2/ln 2) atanh t,    t = (m − 1)/(m + 1), |t| ≤ 0.172: to t⁹ (next term < 1e-9)
-/// z = y log2 x = n + f              n the nearest integer: z + 1.5·2^52 holds n in its low bits
-/// x^y = 2^f · 2^n                   2^f for |f| ≤ ½ from its series to f⁷ (next < 3e-9)
+/// z = y log2 x = n + g              n the nearest integer: z + 1.5·2^52 holds n in its low bits
+/// x^y = 2^g · 2^n                   2^g for |g| ≤ ½ from its series to g⁷ (next term < 6e-9)
 /// ```
 /// No division but the one for t, no float–integer conversion, and both series in Estrin's
 /// scheme. x ≤ 0 gives 0; x is clamped to [1e-300, 1e300].
