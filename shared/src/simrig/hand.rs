@@ -79,8 +79,8 @@ mod tests {
         assert!((h.step(8.0, true, 0.0).unwrap() - 0.35).abs() < 1e-12);
         h.step(9.0, false, 0.0);
         // A turn past hanging (θ = 2π − 0.1): it lifts to 2π + 0.35, not back through a turn.
-        let turn = crate::math::TAU - 0.1;
+        let turn = math::TAU - 0.1;
         h.step(10.0, true, turn);
-        assert!((h.step(11.0, true, 0.0).unwrap() - (crate::math::TAU + 0.35)).abs() < 1e-12);
+        assert!((h.step(11.0, true, 0.0).unwrap() - (math::TAU + 0.35)).abs() < 1e-12);
     }
 }
