@@ -4,8 +4,6 @@
 //! The budget, an hour of CPU, is far above the full `kapitza bench` (about 150 s): what it
 //! refuses is a mistyped setting (`periods = 1e9`), not a long study.
 
-use std::time::Instant;
-
 use anyhow::{bail, Result};
 use kapitza_core::sim::scene::{RunLength, Scene};
 use kapitza_core::sim::sampling::Discard;
@@ -55,39 +53,37 @@ pub fn remaining(elapsed: f64, done: f64) -> Option<f64> {
     (done > 0.0 && elapsed.is_finite()).then(|| elapsed * (1.0 - done.min(1.0)) / done)
 }
 
-/// Drive periods of the shortest pilot run; it doubles until it takes [`PILOT_MIN_S`].
+/// Drive periods of the shortest pilot run; it grows fourfold until it takes [`PILOT_MIN_S`].
 const PILOT_PERIODS: f64 = 16.0;
 /// CPU time a pilot run must take for its rate to be measured (the clock's and the start's
 /// cost made small).
 const PILOT_MIN_S: f64 = 0.02;
-/// Most CPU time the pilots may take in all.
-const PILOT_MAX_S: f64 = 0.5;
+/// The largest share of a run its pilots cover: they add at most 4/3 of it to the run's cost.
+const PILOT_SHARE: f64 = 0.01;
 
 /// The estimated CPU seconds of running `scene` with `options`: pilot runs of its first drive
 /// periods, timed, scaled to its duration. `None` when a pilot fails (the run itself then says
-/// why) or when the pilots cover the whole run (it is short).
+/// why) or when the run is too short for a pilot (under 1600 drive periods).
 pub fn simulation(scene: &Scene, options: &Options) -> Option<f64> {
     let full = PlannedRun::new(scene, options).ok()?;
     let total = full.duration();
     let period = kapitza_core::math::TAU / full.physical.omega;
     let mut pilot = scene.clone();
-    let mut periods = PILOT_PERIODS;
-    let spent = Instant::now();
-    loop {
-        let length = periods * period;
-        if length >= total {
-            return None;
-        }
+    let mut length = PILOT_PERIODS * period;
+    let mut estimate = None;
+    while length <= total * PILOT_SHARE {
         pilot.length = RunLength::Duration(length);
         let run = PlannedRun::new(&pilot, options).ok()?;
         let cpu0 = crate::timing::thread_cpu();
         run.run(&mut Discard).ok()?;
         let cpu = crate::timing::thread_cpu() - cpu0;
-        if cpu >= PILOT_MIN_S || spent.elapsed().as_secs_f64() >= PILOT_MAX_S {
-            return Some(cpu * total / length);
+        estimate = Some(cpu * total / length);
+        if cpu >= PILOT_MIN_S {
+            break;
         }
-        periods *= 4.0;
+        length *= 4.0;
     }
+    estimate
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
 use kapitza_core::model::Geometry;
 use kapitza_core::rig::calibration::Calibration;
 use kapitza_core::rig::closed_loop::ClosedLoopR;

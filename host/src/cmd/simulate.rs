@@ -47,6 +47,9 @@ pub struct Args {
     /// seconds (`--window 1.5s`).
     #[arg(allow_hyphen_values = true, long, value_name = "PERIODS|SECONDSs", default_value = "20")]
     pub window: WindowLength,
+    /// Run even when the estimated CPU time passes the budget (an hour).
+    #[arg(long)]
+    pub no_budget: bool,
 }
 
 /// The length of the end window: drive periods, or seconds with an `s`.
