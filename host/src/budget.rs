@@ -5,8 +5,8 @@
 //! refuses is a mistyped setting (`periods = 1e9`), not a long study.
 
 use anyhow::{bail, Result};
-use kapitza_core::sim::scene::{RunLength, Scene};
 use kapitza_core::sim::sampling::Discard;
+use kapitza_core::sim::scene::{RunLength, Scene};
 use kapitza_core::sim::{Options, PlannedRun};
 
 /// Estimated CPU seconds past which a command refuses to start without `--no-budget`.
@@ -94,7 +94,10 @@ mod tests {
     fn the_budget_refuses_past_an_hour_and_names_the_estimate() {
         check("this run", 3599.0, false).unwrap();
         let msg = format!("{:#}", check("this run", 5.0e4, false).unwrap_err());
-        assert!(msg.contains("about 14 h") && msg.contains("--no-budget"), "{msg}");
+        assert!(
+            msg.contains("about 14 h") && msg.contains("--no-budget"),
+            "{msg}"
+        );
         check("this run", 5.0e4, true).unwrap();
         // A cost that cannot be estimated as finite is past any budget.
         assert!(check("this run", f64::NAN, false).is_err());

@@ -156,17 +156,26 @@ pub fn create_output(flag: &str, path: &Path, mode: Existing) -> Result<File> {
 
 /// Whether `file` (just opened) is empty: a log appended to writes its header only then.
 pub fn is_empty(file: &File) -> bool {
-    file.metadata().map_or(true, |m| !m.is_file() || m.len() == 0)
+    file.metadata()
+        .map_or(true, |m| !m.is_file() || m.len() == 0)
 }
 
 /// Checks before any work that the output directory `dir` (given with `flag`) exists (creating
 /// it) and is writable. Its generated files are regenerated.
 pub fn check_out_dir(flag: &str, dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("{flag} {}: cannot create the output directory", dir.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| {
+        format!(
+            "{flag} {}: cannot create the output directory",
+            dir.display()
+        )
+    })?;
     let probe = dir.join(".kapitza-write-check");
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("{flag} {}: cannot write into the output directory", dir.display()))?;
+    std::fs::write(&probe, b"").with_context(|| {
+        format!(
+            "{flag} {}: cannot write into the output directory",
+            dir.display()
+        )
+    })?;
     let _ = std::fs::remove_file(probe);
     Ok(())
 }
@@ -199,7 +208,10 @@ mod tests {
     fn a_new_file_needs_its_folder() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("missing").join("x.toml");
-        let msg = format!("{:#}", check_output("--backup", &p, Existing::Refuse).unwrap_err());
+        let msg = format!(
+            "{:#}",
+            check_output("--backup", &p, Existing::Refuse).unwrap_err()
+        );
         assert!(msg.contains("does not exist"), "{msg}");
         let p = dir.path().join("x.toml");
         create_output("--backup", &p, Existing::Refuse).unwrap();
@@ -211,7 +223,10 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let msg = format!("{:#}", check_input("--sim", dir.path()).unwrap_err());
         assert!(msg.contains("a directory, not a regular file"), "{msg}");
-        let msg = format!("{:#}", check_output("--truth", dir.path(), Existing::Overwrite).unwrap_err());
+        let msg = format!(
+            "{:#}",
+            check_output("--truth", dir.path(), Existing::Overwrite).unwrap_err()
+        );
         assert!(msg.contains("is a directory"), "{msg}");
     }
 

@@ -66,10 +66,22 @@ fn rig_serve_keeps_an_existing_truth_file_unless_forced_or_appended() {
     let o = run(&["rig", "serve", "--truth", t, "--duration", "0.2"]);
     refused(&o, 1, &["--truth", "exists", "--force", "--append"]);
     // Refused before the pseudo-terminal: no device path printed.
-    assert!(o.stdout.is_empty(), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(
+        o.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     assert_eq!(std::fs::read(&truth).unwrap(), b"earlier measurement\n");
 
-    let o = run(&["rig", "serve", "--truth", t, "--append", "--duration", "0.2"]);
+    let o = run(&[
+        "rig",
+        "serve",
+        "--truth",
+        t,
+        "--append",
+        "--duration",
+        "0.2",
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(std::fs::read(&truth)
         .unwrap()
@@ -87,7 +99,9 @@ fn monitor_keeps_an_existing_csv_unless_forced_or_appended() {
     let dir = tempfile::tempdir().unwrap();
     let csv = earlier(dir.path(), "log.csv");
     let c = csv.to_str().unwrap();
-    let base = ["monitor", "--port", "sim", "--speed", "0", "--plain", "--csv", c];
+    let base = [
+        "monitor", "--port", "sim", "--speed", "0", "--plain", "--csv", c,
+    ];
     let with = |extra: &[&'static str]| {
         let mut a: Vec<&str> = base.to_vec();
         a.extend_from_slice(extra);
@@ -120,7 +134,15 @@ fn calibrate_keeps_an_existing_backup_and_writes_its_own_outside_the_current_fol
     let dir = tempfile::tempdir().unwrap();
     let backup = earlier(dir.path(), "before.toml");
     let b = backup.to_str().unwrap();
-    let cal = ["calibrate", "--port", "sim", "--speed", "0", "--yes", "--plain"];
+    let cal = [
+        "calibrate",
+        "--port",
+        "sim",
+        "--speed",
+        "0",
+        "--yes",
+        "--plain",
+    ];
     let with = |extra: &[&str], env: &[(&str, &str)], cwd: Option<&Path>| {
         let mut a: Vec<&str> = cal.to_vec();
         a.extend_from_slice(extra);
@@ -134,7 +156,10 @@ fn calibrate_keeps_an_existing_backup_and_writes_its_own_outside_the_current_fol
     let o = with(&["--backup", b, "--force"], &[], None);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let saved = std::fs::read_to_string(&backup).unwrap();
-    assert!(saved.contains("[calibration]"), "the configuration as TOML: {saved}");
+    assert!(
+        saved.contains("[calibration]"),
+        "the configuration as TOML: {saved}"
+    );
 
     // Without --backup: a new file in $XDG_STATE_HOME/kapitza/backups, none in the folder
     // the command ran in.
@@ -188,7 +213,16 @@ fn a_fifo_given_as_an_input_never_blocks() {
         &["rig", "serve", "--sim", f, "--duration", "1"],
         &["status", "--port", "sim", "--sim", f],
         &["config", "set", "--port", "sim", f],
-        &["monitor", "--port", "sim", "--sim", f, "--plain", "--duration", "1"],
+        &[
+            "monitor",
+            "--port",
+            "sim",
+            "--sim",
+            f,
+            "--plain",
+            "--duration",
+            "1",
+        ],
     ];
     for args in cases {
         let o = run(args);
@@ -196,7 +230,11 @@ fn a_fifo_given_as_an_input_never_blocks() {
     }
     // A directory, too.
     let d = dir.path().to_str().unwrap();
-    refused(&run(&["simulate", d]), 1, &["a directory, not a regular file"]);
+    refused(
+        &run(&["simulate", d]),
+        1,
+        &["a directory, not a regular file"],
+    );
 }
 
 #[test]
@@ -214,7 +252,9 @@ fn sim_options_beside_a_real_port_are_refused() {
     let o = run(&["status", "--port", "/dev/ttyKAPITZA-none", "--speed", "5"]);
     refused(&o, 1, &["--speed 5", "acts only with --port sim"]);
     // Restating the default is no combination that cannot act.
-    let o = run(&["status", "--port", "sim", "--speed", "1", "--sim", &rig, "--json"]);
+    let o = run(&[
+        "status", "--port", "sim", "--speed", "1", "--sim", &rig, "--json",
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
 
@@ -243,9 +283,17 @@ fn negative_numbers_in_e_notation_are_numbers() {
         assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
     }
     // Out of range, a negative is refused by the option that took it, not as a flag.
-    let e = refused(&run(&["boundary", "--k", "-3e1"]), 1, &["--k -30", "|k| <= 25"]);
+    let e = refused(
+        &run(&["boundary", "--k", "-3e1"]),
+        1,
+        &["--k -30", "|k| <= 25"],
+    );
     assert!(!e.contains("unexpected argument"), "{e}");
-    let e = refused(&run(&["boundary", "--k", "-0.1", "--tol", "-1e-9"]), 1, &["--tol"]);
+    let e = refused(
+        &run(&["boundary", "--k", "-0.1", "--tol", "-1e-9"]),
+        1,
+        &["--tol"],
+    );
     assert!(!e.contains("unexpected argument"), "{e}");
 }
 
@@ -285,11 +333,30 @@ fn degenerate_settings_are_refused_by_name() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     // Tolerances of 0.
-    let o = run(&["simulate", &full, "--set", "run.rtol=0", "--set", "run.atol=0"]);
+    let o = run(&[
+        "simulate",
+        &full,
+        "--set",
+        "run.rtol=0",
+        "--set",
+        "run.atol=0",
+    ]);
     refused(&o, 1, &["run.rtol"]);
-    refused(&run(&["boundary", "--k", "-0.1", "--tol", "0"]), 1, &["--tol 0"]);
+    refused(
+        &run(&["boundary", "--k", "-0.1", "--tol", "0"]),
+        1,
+        &["--tol 0"],
+    );
     // Step counts past 1e8.
-    let o = run(&["boundary", "--k", "-0.1", "--q", "5", "--steps", "1000000000"]);
+    let o = run(&[
+        "boundary",
+        "--k",
+        "-0.1",
+        "--q",
+        "5",
+        "--steps",
+        "1000000000",
+    ]);
     refused(&o, 1, &["--steps 1000000000", "1e8"]);
 }
 
@@ -308,6 +375,15 @@ fn work_past_the_budget_is_refused_with_its_estimate_before_it_runs() {
         "run.periods=1e9",
     ];
     let o = run(&args);
-    refused(&o, 1, &["would take about", "of CPU", "--no-budget", "nothing was run"]);
+    refused(
+        &o,
+        1,
+        &[
+            "would take about",
+            "of CPU",
+            "--no-budget",
+            "nothing was run",
+        ],
+    );
     assert!(o.stdout.is_empty());
 }

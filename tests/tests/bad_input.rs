@@ -161,7 +161,13 @@ const NUMERIC: &[&str] = &[
 /// `line` with `{}` replaced by `value`, split as a shell would.
 fn with_value(line: &str, value: &str) -> Vec<String> {
     line.split(' ')
-        .map(|w| if w == "{}" { value.to_string() } else { w.to_string() })
+        .map(|w| {
+            if w == "{}" {
+                value.to_string()
+            } else {
+                w.to_string()
+            }
+        })
         .collect()
 }
 

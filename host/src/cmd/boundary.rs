@@ -72,7 +72,12 @@ pub struct Args {
     )]
     pub quality: Option<f64>,
     /// Floquet: tolerance on each boundary in m.
-    #[arg(allow_hyphen_values = true, long, value_name = "TOL", default_value_t = 1e-7)]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "TOL",
+        default_value_t = 1e-7
+    )]
     pub tol: f64,
     /// Floquet with damping: RK4 steps per drive period of tr M (default 1000; integrated over
     /// half a period). Undamped ends come from Hill's determinant and need no steps. Refused

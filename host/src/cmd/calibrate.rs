@@ -56,7 +56,11 @@ pub struct Args {
 /// `~/.local/state/kapitza/backups` (`%LOCALAPPDATA%\kapitza\backups` on Windows). A user's
 /// state, kept apart from whatever folder the command ran in.
 pub fn backup_dir() -> Result<PathBuf> {
-    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let var = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
     let base = var("XDG_STATE_HOME")
         .or_else(|| var("HOME").map(|h| h.join(".local").join("state")))
         .or_else(|| var("LOCALAPPDATA"))
@@ -88,12 +92,13 @@ fn new_default_backup() -> Result<(std::fs::File, PathBuf)> {
         {
             Ok(f) => return Ok((f, path)),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => {
-                return Err(e).with_context(|| format!("cannot create {}", path.display()))
-            }
+            Err(e) => return Err(e).with_context(|| format!("cannot create {}", path.display())),
         }
     }
-    anyhow::bail!("{}: no free backup name; give one with --backup FILE", dir.display())
+    anyhow::bail!(
+        "{}: no free backup name; give one with --backup FILE",
+        dir.display()
+    )
 }
 
 #[derive(Serialize)]

@@ -40,12 +40,7 @@ pub struct Args {
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive amplitude A (m): half the peak-to-peak stroke. With --rod or --point.
-    #[arg(
-        long,
-        value_name = "A",
-        requires = "omega",
-        allow_hyphen_values = true
-    )]
+    #[arg(long, value_name = "A", requires = "omega", allow_hyphen_values = true)]
     pub amplitude: Option<f64>,
     /// Drive angular frequency ω (rad/s). With --rod or --point.
     #[arg(

@@ -20,7 +20,12 @@ pub struct RigArgs {
     #[arg(long, value_name = "FILE")]
     pub sim: Option<PathBuf>,
     /// With `--port sim`: rig seconds per wall second (0: as fast as the laptop reads).
-    #[arg(allow_hyphen_values = true, long, default_value_t = 1.0, value_name = "X")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        default_value_t = 1.0,
+        value_name = "X"
+    )]
     pub speed: f64,
 }
 

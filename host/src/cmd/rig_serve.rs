@@ -37,7 +37,12 @@ pub struct ServeArgs {
     #[arg(long, value_name = "FILE")]
     pub sim: Option<PathBuf>,
     /// Rig seconds per wall second (the link-silence timeout stays on wall time).
-    #[arg(allow_hyphen_values = true, long, default_value_t = 1.0, value_name = "X")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        default_value_t = 1.0,
+        value_name = "X"
+    )]
     pub speed: f64,
     /// Also publish the device as this symlink (an existing symlink there is replaced).
     #[arg(long, value_name = "PATH")]
@@ -127,9 +132,9 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         .map(|d| crate::input::positive("--duration", d))
         .transpose()?;
     let mut truth = match &a.truth {
-        Some(p) => Some(BufWriter::new(
-            files::create_output("--truth", p, existing)?,
-        )),
+        Some(p) => Some(BufWriter::new(files::create_output(
+            "--truth", p, existing,
+        )?)),
         None => None,
     };
     let (mut master, slave) = TTYPort::pair().context("cannot open a pseudo-terminal")?;

@@ -45,7 +45,12 @@ pub struct Args {
     pub samples_per_period: u32,
     /// The end of the run the plots draw at full resolution: drive periods (`--window 20`) or
     /// seconds (`--window 1.5s`).
-    #[arg(allow_hyphen_values = true, long, value_name = "PERIODS|SECONDSs", default_value = "20")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "PERIODS|SECONDSs",
+        default_value = "20"
+    )]
     pub window: WindowLength,
     /// Run even when the estimated CPU time passes the budget (an hour).
     #[arg(long)]

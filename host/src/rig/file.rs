@@ -58,11 +58,14 @@ fn scene_instead(text: &str) -> bool {
     let Ok(t) = text.parse::<toml::Table>() else {
         return false;
     };
-    let drive_keys = t.get("drive").and_then(toml::Value::as_table).is_some_and(|d| {
-        ["omega", "angle_deg", "r", "frequency_hz"]
-            .iter()
-            .any(|k| d.contains_key(*k))
-    });
+    let drive_keys = t
+        .get("drive")
+        .and_then(toml::Value::as_table)
+        .is_some_and(|d| {
+            ["omega", "angle_deg", "r", "frequency_hz"]
+                .iter()
+                .any(|k| d.contains_key(*k))
+        });
     t.contains_key("run") || t.contains_key("expect") || drive_keys
 }
 

@@ -182,7 +182,9 @@ fn not_a_terminal(path: &str) -> Result<()> {
             .open(path);
         match f {
             // SAFETY: isatty on a descriptor this function owns.
-            Ok(f) if unsafe { libc::isatty(f.as_raw_fd()) } == 0 => "a device that is not a terminal",
+            Ok(f) if unsafe { libc::isatty(f.as_raw_fd()) } == 0 => {
+                "a device that is not a terminal"
+            }
             // A terminal, or an error the serial layer reports in its own words.
             _ => return Ok(()),
         }

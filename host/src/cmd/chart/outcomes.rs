@@ -38,7 +38,12 @@ pub struct Args {
     #[arg(long, value_name = "KEY=FROM..TO", allow_hyphen_values = true)]
     pub y: Sweep,
     /// Cells NxM along x and y, both ends included.
-    #[arg(allow_hyphen_values = true, long, value_name = "NxM", default_value = "21x21")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "NxM",
+        default_value = "21x21"
+    )]
     pub size: Size,
     /// Further overrides applied to every cell (KEY=VALUE, as in `simulate --set`).
     #[arg(long, value_name = "KEY=VALUE")]

@@ -32,7 +32,12 @@ pub struct Args {
     #[arg(long, value_name = "FROM..TO", default_value = "0..3")]
     pub r_range: Range,
     /// Samples NxM of θd (0…180°) and R.
-    #[arg(allow_hyphen_values = true, long, value_name = "NxM", default_value = "361x301")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "NxM",
+        default_value = "361x301"
+    )]
     pub size: Size,
     #[command(flatten)]
     pub output: Output,
