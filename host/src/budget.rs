@@ -29,7 +29,9 @@ pub fn human(seconds: f64) -> String {
 /// Refuses `what` (e.g. "this run") when its estimated CPU time passes [`BUDGET_S`], unless
 /// `no_budget`.
 pub fn check(what: &str, estimate_s: f64, no_budget: bool) -> Result<()> {
-    if !no_budget && !(estimate_s <= BUDGET_S) {
+    // A NaN estimate is past any budget.
+    let within = estimate_s.is_finite() && estimate_s <= BUDGET_S;
+    if !no_budget && !within {
         bail!(
             "{what} would take about {} of CPU (estimated before starting), past the budget of \
              {}: nothing was run. Shorten it, or give --no-budget to run it anyway",
@@ -68,7 +70,7 @@ pub fn simulation(scene: &Scene, options: &Options) -> Option<f64> {
     let full = PlannedRun::new(scene, options).ok()?;
     let total = full.duration();
     let period = kapitza_core::math::TAU / full.physical.omega;
-    let mut pilot = scene.clone();
+    let mut pilot = *scene;
     let mut length = PILOT_PERIODS * period;
     let mut estimate = None;
     while length <= total * PILOT_SHARE {
