@@ -19,7 +19,7 @@ pub fn human(seconds: f64) -> String {
     }
     match seconds {
         s if s < 90.0 => format!("{s:.0} s"),
-        s if s < 5400.0 => format!("{:.0} min", s / 60.0),
+        s if s < 3600.0 => format!("{:.0} min", s / 60.0),
         s if s < 2.0 * 86_400.0 => format!("{:.1} h", s / 3600.0),
         s if s < 730.0 * 86_400.0 => format!("{:.0} days", s / 86_400.0),
         s => format!("{:.0} years", s / (365.25 * 86_400.0)),
@@ -97,7 +97,9 @@ mod tests {
         check("this run", 3599.0, false).unwrap();
         let msg = format!("{:#}", check("this run", 5.0e4, false).unwrap_err());
         assert!(
-            msg.contains("about 14 h") && msg.contains("--no-budget"),
+            msg.contains("about 13.9 h")
+                && msg.contains("budget of 1.0 h")
+                && msg.contains("--no-budget"),
             "{msg}"
         );
         check("this run", 5.0e4, true).unwrap();
