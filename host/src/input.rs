@@ -5,8 +5,9 @@
 
 use anyhow::{bail, Result};
 use clap::Args;
-use kapitza_core::error::Range;
+use kapitza_core::error::{Compact, Range};
 use kapitza_core::model::{Geometry, Groups};
+use kapitza_core::stability::DELTA_MAX;
 
 /// `v` if `range` admits it, else an error naming the flag.
 fn in_range(flag: &str, v: f64, range: Range) -> Result<f64> {
@@ -29,15 +30,33 @@ pub fn finite(flag: &str, v: f64) -> Result<f64> {
     in_range(flag, v, Range::Finite)
 }
 
+/// `q` (given with `flag`) if the damping per radian of drive it gives at |k| = `k_abs`,
+/// δ = √|k|/Q, stays within the criteria's range ([`DELTA_MAX`]): refused in terms of Q.
+pub fn quality_for(flag: &str, q: f64, k_abs: f64) -> Result<f64> {
+    let q = positive(flag, q)?;
+    if k_abs.sqrt() / q > DELTA_MAX {
+        // Rounded up to 3 significant digits, so the limit printed is itself accepted.
+        let min = k_abs.sqrt() / DELTA_MAX;
+        let scale = 10f64.powi(min.log10().floor() as i32 - 2);
+        bail!(
+            "{flag} {} is out of range: expected at least {} here (damping past δ = √|k|/Q = \
+             {DELTA_MAX} per radian of drive is beyond what the criteria compute)",
+            Compact(q),
+            Compact((min / scale).ceil() * scale)
+        );
+    }
+    Ok(q)
+}
+
 /// The pendulum, given as a uniform rod or a point mass on a light rod.
 #[derive(Debug, Clone, Args)]
 #[group(multiple = false)]
 pub struct GeometryArgs {
     /// Uniform rod of length L (m), pivoted at one end: ℓ = 2L/3.
-    #[arg(long, value_name = "L", allow_negative_numbers = true)]
+    #[arg(long, value_name = "L", allow_hyphen_values = true)]
     pub rod: Option<f64>,
     /// Point mass on a light rod of length l (m): ℓ = l.
-    #[arg(long, value_name = "l", allow_negative_numbers = true)]
+    #[arg(long, value_name = "l", allow_hyphen_values = true)]
     pub point: Option<f64>,
 }
 

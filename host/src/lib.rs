@@ -5,10 +5,12 @@
 //! | module | concept |
 //! |---|---|
 //! | [`bench`] | `kapitza bench`: work-precision, the peer, the stability ladder, the physical question |
+//! | [`budget`] | cost known up front: estimates, the CPU budget, remaining time |
 //! | [`calibrate`] | `kapitza calibrate`: the guided steps over the link, the person at the rig, what is written |
 //! | [`chart`] | the field's charts: stability, equilibria and outcome maps, drawn as PNG and SVG |
 //! | [`cli`] | parsing, dispatch, and the error type that picks the exit status |
 //! | [`demo`] | the lecture demo as a script over the monitor's feed, measured against predicted |
+//! | [`files`] | the file policy: named files never overwritten unless asked, inputs regular files, output directories checked first |
 //! | [`flash`] | flashing the board through a debug probe: the image checked against memory.x first |
 //! | [`input`] | checks of command-line numbers |
 //! | [`link`] | the serial-link client: one method per command; "the line failed" apart from "the rig refused" |
@@ -22,12 +24,14 @@
 //! | [`timing`] | measured cost of a call: wall and thread CPU time, medians of five batches |
 
 pub mod bench;
+pub mod budget;
 pub mod calibrate;
 pub mod chart;
 pub mod cli;
 pub mod cmd;
 pub mod csv_out;
 pub mod demo;
+pub mod files;
 pub mod flash;
 pub mod input;
 pub mod link;

@@ -26,6 +26,65 @@ impl Binary {
         self.command(args).output().unwrap()
     }
 
+    /// Runs it with `env` set and `dir` as its working folder (`None`: this one), stdin empty;
+    /// `None` when it has not ended by `deadline` (it is then killed): a hang, which the
+    /// caller fails on.
+    pub fn run_within(
+        &self,
+        args: &[&str],
+        env: &[(&str, &str)],
+        dir: Option<&std::path::Path>,
+        deadline: Duration,
+    ) -> Option<Output> {
+        let mut c = self.command(args);
+        c.envs(env.iter().copied())
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        if let Some(d) = dir {
+            c.current_dir(d);
+        }
+        let mut child = c.spawn().unwrap();
+        let drain = |r: Option<Box<dyn Read + Send>>| {
+            std::thread::spawn(move || {
+                let mut v = Vec::new();
+                if let Some(mut r) = r {
+                    let _ = r.read_to_end(&mut v);
+                }
+                v
+            })
+        };
+        let out = drain(
+            child
+                .stdout
+                .take()
+                .map(|s| Box::new(s) as Box<dyn Read + Send>),
+        );
+        let err = drain(
+            child
+                .stderr
+                .take()
+                .map(|s| Box::new(s) as Box<dyn Read + Send>),
+        );
+        let end = Instant::now() + deadline;
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if Instant::now() >= end {
+                let _ = child.kill();
+                let _ = child.wait();
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        Some(Output {
+            status,
+            stdout: out.join().unwrap(),
+            stderr: err.join().unwrap(),
+        })
+    }
+
     /// Starts it and reads its first line of stdout (a served rig's device path, an owner's
     /// "attached …"); the rest is collected until it ends.
     pub fn start(&self, args: &[&str]) -> Running {

@@ -76,13 +76,7 @@ pub fn save<F: Figure>(dir: &Path, stem: &str, fig: &F) -> Result<Vec<PathBuf>> 
 
 /// Checks before any work that `dir` exists (creating it) and is writable.
 pub fn prepare_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the output directory {}", dir.display()))?;
-    let probe = dir.join(".kapitza-write-check");
-    std::fs::write(&probe, b"")
-        .with_context(|| format!("cannot write into the output directory {}", dir.display()))?;
-    let _ = std::fs::remove_file(probe);
-    Ok(())
+    crate::files::check_out_dir("--out", dir)
 }
 
 /// A light tint of a colour, for shaded regions.

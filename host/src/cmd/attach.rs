@@ -18,7 +18,7 @@ pub struct Args {
     #[command(flatten)]
     pub rig: RigArgs,
     /// Exit after this many seconds (default: until Ctrl-C); the drive is stopped either way.
-    #[arg(long, value_name = "S")]
+    #[arg(allow_hyphen_values = true, long, value_name = "S")]
     pub duration: Option<f64>,
 }
 

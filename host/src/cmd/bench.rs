@@ -2,7 +2,7 @@
 //! the ratio to a peer at matched error, and where accuracy stops mattering.
 
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
@@ -37,7 +37,7 @@ impl Bar {
             ProgressDrawTarget::hidden()
         };
         let bar = ProgressBar::with_draw_target(Some(1), target);
-        if let Ok(style) = ProgressStyle::with_template(
+        if let Some(style) = crate::record::style(
             "measuring {wide_bar} {pos}/{len}  {elapsed}, about {eta} left  {msg}",
         ) {
             bar.set_style(style);
@@ -69,6 +69,10 @@ fn command(args: &Args) -> String {
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
+    // An unwritable --out must not throw away a whole benchmark: checked before it.
+    if let Some(dir) = &args.out {
+        crate::files::check_out_dir("--out", dir)?;
+    }
     let plan = if args.quick {
         Plan::quick()
     } else {
@@ -80,7 +84,6 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let results = results?;
     let json = serde_json::to_string_pretty(&results)?;
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let path = dir.join("bench.json");
         std::fs::write(&path, &json).with_context(|| format!("cannot write {}", path.display()))?;
         let path = dir.join("report.md");

@@ -11,7 +11,9 @@ use std::time::Duration;
 use crate::input::{self, GeometryArgs};
 use crate::timing::seconds_per_eval;
 use kapitza_core::model::Groups;
-use kapitza_core::stability::{averaging, harmonic_balance, hill, mathieu, End, Window, K_MAX};
+use kapitza_core::stability::{
+    averaging, harmonic_balance, hill, mathieu, End, Window, DELTA_MAX, K_MAX,
+};
 
 /// Subharmonic orders reported (n = 2 is the flutter boundary).
 const ORDERS: std::ops::RangeInclusive<u32> = 2..=8;
@@ -28,26 +30,26 @@ const BATCH: Duration = Duration::from_millis(20);
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Signed k = ±(ω0/ω)²: < 0 about the inverted position, > 0 about the hanging one.
-    #[arg(long, value_name = "K", allow_negative_numbers = true,
+    #[arg(long, value_name = "K", allow_hyphen_values = true,
           required_unless_present_any = ["rod", "point"],
           conflicts_with_all = ["rod", "point", "omega", "damping", "hanging", "amplitude"])]
     pub k: Option<f64>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive angular frequency ω (rad/s). With --rod or --point.
-    #[arg(long, value_name = "W", allow_negative_numbers = true)]
+    #[arg(long, value_name = "W", allow_hyphen_values = true)]
     pub omega: Option<f64>,
     /// Pivot amplitude A (m), half the stroke. With --rod or --point instead of --omega: the
     /// window of ω (rad/s, Hz, rpm) in which that stroke holds the inverted position (exact,
     /// undamped), with ωc explained.
-    #[arg(long, value_name = "A", allow_negative_numbers = true, conflicts_with_all = ["omega", "hanging", "damping", "quality"])]
+    #[arg(long, value_name = "A", allow_hyphen_values = true, conflicts_with_all = ["omega", "hanging", "damping", "quality"])]
     pub amplitude: Option<f64>,
     /// Gravity g (m/s²). With --rod or --point.
     #[arg(
         long,
         value_name = "G",
         default_value_t = 9.81,
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub gravity: f64,
     /// Study the hanging position (k > 0) instead of the inverted one. With --rod or --point.
@@ -58,7 +60,7 @@ pub struct Args {
         long,
         value_name = "C",
         conflicts_with = "quality",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub damping: Option<f64>,
     /// Quality factor Q = ω0/c of the damping (δ = c/ω = √|k|/Q).
@@ -66,17 +68,25 @@ pub struct Args {
         long = "q",
         id = "quality",
         value_name = "Q",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub quality: Option<f64>,
     /// Floquet: tolerance on each boundary in m.
-    #[arg(long, value_name = "TOL", default_value_t = 1e-7)]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "TOL",
+        default_value_t = 1e-7
+    )]
     pub tol: f64,
     /// Floquet with damping: RK4 steps per drive period of tr M (default 1000; integrated over
     /// half a period). Undamped ends come from Hill's determinant and need no steps. Refused
     /// when doubling it moves an end by more than --tol: such a setting cannot be converged.
-    #[arg(long, value_name = "N")]
+    #[arg(allow_hyphen_values = true, long, value_name = "N")]
     pub steps: Option<u32>,
+    /// Run even when the estimated CPU time passes the budget (an hour).
+    #[arg(long)]
+    pub no_budget: bool,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -198,6 +208,9 @@ fn problem(args: &Args) -> Result<Problem> {
             bail!("--k {k} is out of range: expected |k| <= {K_MAX}");
         }
         // δ = c/ω and Q = ω0/c with ω0/ω = √|k|: δ = √|k|/Q.
+        let quality = quality
+            .map(|q| input::quality_for("--q", q, k.abs()))
+            .transpose()?;
         let delta = quality.map_or(0.0, |q| k.abs().sqrt() / q);
         return Ok(Problem {
             k,
@@ -217,9 +230,16 @@ fn problem(args: &Args) -> Result<Problem> {
     let omega0 = (gravity / ell).sqrt();
     let c = match (args.damping, quality) {
         (Some(c), _) => input::non_negative("--damping", c)?,
-        (None, Some(q)) => omega0 / q,
+        (None, Some(q)) => omega0 / input::quality_for("--q", q, (omega0 / omega).powi(2))?,
         (None, None) => 0.0,
     };
+    if c / omega > DELTA_MAX {
+        bail!(
+            "--damping {c} is out of range for --omega {omega}: expected at most {} (δ = c/ω \
+             past {DELTA_MAX} per radian of drive is beyond what the criteria compute)",
+            DELTA_MAX * omega
+        );
+    }
     // The amplitude only scales m; any positive value gives the same k and δ.
     let g = Groups::new(ell, gravity, ell, omega, c)?;
     let k = g.k(!args.hanging);
@@ -261,6 +281,19 @@ fn floquet_window(
     Ok((d.window, d.traces, evals, d.counts))
 }
 
+/// Most RK4 steps per drive period: 1e8 already takes minutes for one window.
+const MAX_STEPS: u32 = 100_000_000;
+
+/// Estimated CPU seconds of the damped Floquet work at `half_steps`: one window at the default
+/// steps, timed and scaled by the steps, for the reference, the check at twice the steps (2×)
+/// and the timing batches (at least 5 windows).
+fn estimate(k: f64, delta: f64, tol: f64, half_steps: u32) -> Result<f64> {
+    let cpu0 = crate::timing::thread_cpu();
+    floquet_window(k, delta, tol, hill::DEFAULT_HALF_STEPS)?;
+    let cpu = crate::timing::thread_cpu() - cpu0;
+    Ok(cpu * f64::from(half_steps) / f64::from(hill::DEFAULT_HALF_STEPS) * 8.0)
+}
+
 /// Refuses a step count whose damped ends move by more than `tol` when it is doubled.
 fn check_converged(k: f64, delta: f64, tol: f64, half_steps: u32, w: &Window) -> Result<()> {
     let (finer, ..) = floquet_window(k, delta, tol, 2 * half_steps)?;
@@ -286,11 +319,16 @@ pub fn compute(args: &Args) -> Result<Report> {
     let p = problem(args)?;
     let tol = input::positive("--tol", args.tol)?;
     let steps = args.steps.unwrap_or(2 * hill::DEFAULT_HALF_STEPS);
-    if steps < 2 {
-        bail!("--steps {steps} is out of range: expected at least 2");
+    if !(2..=MAX_STEPS).contains(&steps) {
+        bail!("--steps {steps} is out of range: expected 2 to 1e8");
     }
     let half_steps = steps / 2;
     let (k, delta) = (p.k, p.delta);
+    if delta > 0.0 && half_steps > hill::DEFAULT_HALF_STEPS {
+        let cpu = estimate(k, delta, tol, half_steps)?;
+        crate::budget::check("this boundary", cpu, args.no_budget)?;
+        crate::budget::announce("boundary", cpu);
+    }
     let ell = p.physical.as_ref().map(|ph| ph.equivalent_length);
     let undamped = (delta > 0.0).then_some("undamped value: only Floquet includes damping");
 

@@ -8,7 +8,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
 use kapitza_core::model::Geometry;
 use kapitza_core::rig::calibration::Calibration;
 use kapitza_core::rig::closed_loop::ClosedLoopR;
@@ -293,8 +293,7 @@ pub fn to_toml(cfg: &RigConfig) -> Result<String> {
 
 /// The configuration `file` describes, on top of `current`.
 pub fn read(file: &std::path::Path, current: &RigConfig) -> Result<RigConfig> {
-    let text =
-        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    let text = crate::files::read_input("the configuration file", file)?;
     let over: toml::Table = text
         .parse()
         .map_err(|e| anyhow!("{}: {e}", file.display()))?;
@@ -319,6 +318,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
             }
         }
         Action::Set { rig, file } => {
+            crate::files::check_input("the configuration file", file)?;
             let mut s = rig.connect()?;
             let new =
                 read(file, &s.config).map_err(|e| Failure::new(Exit::Refused, format!("{e:#}")))?;

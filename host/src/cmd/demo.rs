@@ -26,7 +26,12 @@ pub struct Args {
     #[arg(long, value_name = "P")]
     pub port: Option<String>,
     /// The simulated rig's pace: X times real time (0: as fast as the demo reads).
-    #[arg(long, value_name = "X", default_value_t = 1.0)]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "X",
+        default_value_t = 1.0
+    )]
     pub speed: f64,
     /// Progress lines and the table instead of the dashboard.
     #[arg(long, conflicts_with = "json")]

@@ -147,6 +147,8 @@ pub fn run_with(args: &Args, lister: &Lister, out: &mut dyn Write) -> Result<()>
                 speed: 1.0,
             },
             csv: None,
+            force: false,
+            append: false,
             duration: None,
             plain: false,
         };

@@ -25,11 +25,18 @@ use crate::rig::simhost::SimOptions;
 pub struct Args {
     #[command(flatten)]
     pub rig: RigArgs,
-    /// Log every telemetry frame to this CSV file (with a header).
+    /// Log every telemetry frame to this CSV file (with a header); an existing file is refused
+    /// unless --force or --append.
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,
+    /// Replace an existing --csv file.
+    #[arg(long, requires = "csv", conflicts_with = "append")]
+    pub force: bool,
+    /// Add rows to the end of an existing --csv file (its header is kept).
+    #[arg(long, requires = "csv")]
+    pub append: bool,
     /// End after S seconds of the rig's clock.
-    #[arg(long, value_name = "S")]
+    #[arg(allow_hyphen_values = true, long, value_name = "S")]
     pub duration: Option<f64>,
     /// One JSON record per telemetry frame instead of the dashboard.
     #[arg(long)]
@@ -47,10 +54,15 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     if let Some(d) = args.duration {
         input::positive("--duration", d)?;
     }
+    let csv_existing = crate::files::Existing::from_flags(args.force, args.append);
+    if let Some(p) = &args.csv {
+        crate::files::check_output("--csv", p, csv_existing)?;
+    }
     let mut feed = open_feed(&args.rig.target()?, &args.rig.sim_options()?)?;
     let opts = Options {
         duration: args.duration,
         csv: args.csv.clone(),
+        csv_existing,
     };
     if args.plain || !std::io::stdout().is_terminal() {
         monitor::run_plain(feed.as_mut(), None, &opts, Plain::Records, out)?;

@@ -20,14 +20,14 @@ use kapitza_core::model::{equilibria, DriveAngle, Equilibrium, Groups, Stability
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Drive strength R = A²ω²/(2gℓ) (>= 0).
-    #[arg(long = "r", value_name = "R", allow_negative_numbers = true, required_unless_present_any = ["rod", "point", "rest_angle"], conflicts_with_all = ["rod", "point", "amplitude", "omega"])]
+    #[arg(long = "r", value_name = "R", allow_hyphen_values = true, required_unless_present_any = ["rod", "point", "rest_angle"], conflicts_with_all = ["rod", "point", "amplitude", "omega"])]
     pub r: Option<f64>,
     /// Drive angle θd in degrees from the downward vertical (0 shakes vertically, 90
     /// horizontally, 180 vertically along the upward direction).
     #[arg(
         long,
         value_name = "DEG",
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         required_unless_present = "rest_angle",
         conflicts_with = "rest_angle"
     )]
@@ -35,24 +35,19 @@ pub struct Args {
     /// Instead of --angle: the wanted rest angle φ0 (degrees). Prints every drive angle that
     /// puts a stable equilibrium within 90° of the drive there (at the R given, if any), and the
     /// range of R for which one exists — or says that none does.
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub rest_angle: Option<f64>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive amplitude A (m): half the peak-to-peak stroke. With --rod or --point.
-    #[arg(
-        long,
-        value_name = "A",
-        requires = "omega",
-        allow_negative_numbers = true
-    )]
+    #[arg(long, value_name = "A", requires = "omega", allow_hyphen_values = true)]
     pub amplitude: Option<f64>,
     /// Drive angular frequency ω (rad/s). With --rod or --point.
     #[arg(
         long,
         value_name = "W",
         requires = "amplitude",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub omega: Option<f64>,
     /// Gravity g (m/s²).
@@ -60,7 +55,7 @@ pub struct Args {
         long,
         value_name = "G",
         default_value_t = 9.81,
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub gravity: f64,
     /// Print JSON instead of a table.

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use crate::rig::file::{self, RigFile};
 use crate::rig::port::{self, Target};
@@ -20,13 +20,37 @@ pub struct RigArgs {
     #[arg(long, value_name = "FILE")]
     pub sim: Option<PathBuf>,
     /// With `--port sim`: rig seconds per wall second (0: as fast as the laptop reads).
-    #[arg(long, default_value_t = 1.0, value_name = "X")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        default_value_t = 1.0,
+        value_name = "X"
+    )]
     pub speed: f64,
 }
 
 impl RigArgs {
+    /// The rig `--port` names; `--sim` or a `--speed` other than 1 beside a real port is
+    /// refused, as they cannot act on it.
     pub fn target(&self) -> Result<Target> {
-        port::resolve(self.port.as_deref())
+        let target = port::resolve(self.port.as_deref())?;
+        if let Target::Serial { path } = &target {
+            if let Some(f) = &self.sim {
+                bail!(
+                    "--sim {} acts only with --port sim; {path} is a real rig (its physics is \
+                     its own): drop --sim, or use --port sim",
+                    f.display()
+                );
+            }
+            if self.speed != 1.0 {
+                bail!(
+                    "--speed {} acts only with --port sim; {path} is a real rig and runs in real \
+                     time: drop --speed, or use --port sim",
+                    self.speed
+                );
+            }
+        }
+        Ok(target)
     }
 
     pub fn sim_options(&self) -> Result<SimOptions> {

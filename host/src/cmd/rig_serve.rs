@@ -5,7 +5,6 @@
 //! also publishes it as a stable symlink, so a restarted rig is found at the same name. The pty's
 //! other end stays open here, so a client may come and go.
 
-use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::os::fd::AsRawFd;
 use std::path::PathBuf;
@@ -15,6 +14,7 @@ use anyhow::{bail, Context, Result};
 use serialport::{SerialPort, TTYPort};
 
 use super::rig_args::RigArgs;
+use crate::files;
 use crate::rig::simhost::{self, Line};
 use crate::rig::{self as rigmod};
 
@@ -37,16 +37,28 @@ pub struct ServeArgs {
     #[arg(long, value_name = "FILE")]
     pub sim: Option<PathBuf>,
     /// Rig seconds per wall second (the link-silence timeout stays on wall time).
-    #[arg(long, default_value_t = 1.0, value_name = "X")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        default_value_t = 1.0,
+        value_name = "X"
+    )]
     pub speed: f64,
     /// Also publish the device as this symlink (an existing symlink there is replaced).
     #[arg(long, value_name = "PATH")]
     pub link: Option<PathBuf>,
-    /// Write every setting the rig applied to this file, one JSON line each.
+    /// Write every setting the rig applied to this file, one JSON line each (an existing file
+    /// is refused unless --force or --append).
     #[arg(long, value_name = "FILE")]
     pub truth: Option<PathBuf>,
+    /// Replace an existing --truth file.
+    #[arg(long, requires = "truth", conflicts_with = "append")]
+    pub force: bool,
+    /// Add to the end of an existing --truth file.
+    #[arg(long, requires = "truth")]
+    pub append: bool,
     /// Stop after this many wall seconds (default: run until Ctrl-C).
-    #[arg(long, value_name = "S")]
+    #[arg(allow_hyphen_values = true, long, value_name = "S")]
     pub duration: Option<f64>,
     /// Speak this link protocol version instead of this tool's (for tests of version skew).
     #[arg(long, hide = true)]
@@ -104,6 +116,10 @@ fn publish(link: &std::path::Path, target: &str) -> Result<()> {
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let Action::Serve(a) = &args.action;
+    let existing = files::Existing::from_flags(a.force, a.append);
+    if let Some(p) = &a.truth {
+        files::check_output("--truth", p, existing)?;
+    }
     let rig = RigArgs {
         port: None,
         sim: a.sim.clone(),
@@ -116,9 +132,9 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         .map(|d| crate::input::positive("--duration", d))
         .transpose()?;
     let mut truth = match &a.truth {
-        Some(p) => Some(BufWriter::new(
-            File::create(p).with_context(|| format!("--truth {}", p.display()))?,
-        )),
+        Some(p) => Some(BufWriter::new(files::create_output(
+            "--truth", p, existing,
+        )?)),
         None => None,
     };
     let (mut master, slave) = TTYPort::pair().context("cannot open a pseudo-terminal")?;

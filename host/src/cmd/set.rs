@@ -39,7 +39,13 @@ pub struct Args {
     #[arg(long)]
     pub wait: bool,
     /// With --wait: seconds (wall time) to wait for it.
-    #[arg(long, default_value_t = 120.0, value_name = "S", requires = "wait")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        default_value_t = 120.0,
+        value_name = "S",
+        requires = "wait"
+    )]
     pub timeout: f64,
     /// One JSON object at the end (the keys of `kapitza status --json`); progress goes to stderr.
     #[arg(long)]

@@ -41,12 +41,20 @@ pub struct Args {
     pub check: bool,
     /// Time-series samples per drive period for series.csv (at most 200 000 samples in all:
     /// long runs keep every n-th). The plots sample at least 64 a period.
-    #[arg(long, value_name = "N", default_value_t = 20, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", default_value_t = 20, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub samples_per_period: u32,
     /// The end of the run the plots draw at full resolution: drive periods (`--window 20`) or
     /// seconds (`--window 1.5s`).
-    #[arg(long, value_name = "PERIODS|SECONDSs", default_value = "20")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "PERIODS|SECONDSs",
+        default_value = "20"
+    )]
     pub window: WindowLength,
+    /// Run even when the estimated CPU time passes the budget (an hour).
+    #[arg(long)]
+    pub no_budget: bool,
 }
 
 /// The length of the end window: drive periods, or seconds with an `s`.
@@ -181,6 +189,10 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         ..Options::default()
     };
     let mut planned = PlannedRun::new(&file.scene, &options).map_err(|e| anyhow!("{name}: {e}"))?;
+    if let Some(cpu) = crate::budget::simulation(&file.scene, &options) {
+        crate::budget::check(&format!("{name}: this run"), cpu, args.no_budget)?;
+        crate::budget::announce(&name, cpu);
+    }
     // The output is sized from the plan: its duration, and whether the averaged model runs
     // (its slow state has no fast wobble to resolve).
     let period = math::TAU / planned.physical.omega;

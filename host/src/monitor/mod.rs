@@ -50,6 +50,8 @@ pub struct Options {
     pub duration: Option<f64>,
     /// Log every frame here.
     pub csv: Option<PathBuf>,
+    /// What to do when the log exists (`--force`, `--append`).
+    pub csv_existing: crate::files::Existing,
 }
 
 /// What the loop off a terminal prints.
@@ -81,9 +83,15 @@ impl<'a, 'b> Session<'a, 'b> {
     ) -> Result<Self> {
         let csv = match &opts.csv {
             Some(p) => {
-                let f =
-                    File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
-                Some((plain::Csv::new(BufWriter::new(f)), p.clone()))
+                let f = crate::files::create_output("--csv", p, opts.csv_existing)?;
+                let continuing = !crate::files::is_empty(&f);
+                let w = BufWriter::new(f);
+                let csv = if continuing {
+                    plain::Csv::continuing(w)
+                } else {
+                    plain::Csv::new(w)
+                };
+                Some((csv, p.clone()))
             }
             None => None,
         };

@@ -18,11 +18,24 @@ pub fn json_line(r: &Readings, out: &mut dyn Write) -> io::Result<()> {
 pub struct Csv<W: Write> {
     w: W,
     columns: Option<Vec<String>>,
+    header: bool,
 }
 
 impl<W: Write> Csv<W> {
     pub fn new(w: W) -> Self {
-        Self { w, columns: None }
+        Self {
+            w,
+            columns: None,
+            header: true,
+        }
+    }
+
+    /// Rows added to a log that has its header already (`--append`).
+    pub fn continuing(w: W) -> Self {
+        Self {
+            header: false,
+            ..Self::new(w)
+        }
     }
 
     pub fn row(&mut self, r: &Readings) -> io::Result<()> {
@@ -33,7 +46,9 @@ impl<W: Write> Csv<W> {
             Some(c) => c,
             None => {
                 let names: Vec<String> = fields.keys().cloned().collect();
-                writeln!(self.w, "{}", names.join(","))?;
+                if self.header {
+                    writeln!(self.w, "{}", names.join(","))?;
+                }
                 self.columns.insert(names)
             }
         };

@@ -233,6 +233,19 @@ impl Progress {
     }
 }
 
+/// `template` with its `{eta}` the remaining time at the rate so far ([`crate::budget::remaining`]),
+/// `?` before anything is done: indicatif's own estimate reads "0 s" until its first steps.
+pub fn style(template: &str) -> Option<ProgressStyle> {
+    let eta = |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+        let text = crate::budget::remaining(s.elapsed().as_secs_f64(), f64::from(s.fraction()))
+            .map_or_else(|| "?".to_string(), crate::budget::human);
+        let _ = w.write_str(&text);
+    };
+    ProgressStyle::with_template(template)
+        .ok()
+        .map(|st| st.with_key("eta", eta))
+}
+
 /// A bar of `len` steps drawn with `template`, ticking on its own when drawn.
 pub fn bar(len: u64, template: &str) -> ProgressBar {
     let target = if std::io::stderr().is_terminal() {
@@ -241,7 +254,7 @@ pub fn bar(len: u64, template: &str) -> ProgressBar {
         ProgressDrawTarget::hidden()
     };
     let bar = ProgressBar::with_draw_target(Some(len), target);
-    if let Ok(style) = ProgressStyle::with_template(template) {
+    if let Some(style) = style(template) {
         bar.set_style(style);
     }
     if !bar.is_hidden() {

@@ -40,9 +40,33 @@ impl RigFile {
 
 /// Reads and checks a rig file.
 pub fn load(path: &Path) -> Result<RigFile> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the rig file {}", path.display()))?;
-    parse(&text).with_context(|| format!("rig file {}", path.display()))
+    let text = crate::files::read_input("the rig file", path)?;
+    parse(&text).map_err(|e| match scene_instead(&text) {
+        true => anyhow!(
+            "{} is a scene file (for `kapitza simulate` and `chart`), not a rig file: a rig file \
+             describes a simulated bench's hardware ([motor], [sensor], [servo], …), see docs/rig.md \
+             ({e})",
+            path.display()
+        ),
+        false => e.context(format!("rig file {}", path.display())),
+    })
+}
+
+/// Whether `text` is a scene file: a run, an expectation, or a drive given by its frequency,
+/// R or angle (a rig's drive is its stroke alone).
+fn scene_instead(text: &str) -> bool {
+    let Ok(t) = text.parse::<toml::Table>() else {
+        return false;
+    };
+    let drive_keys = t
+        .get("drive")
+        .and_then(toml::Value::as_table)
+        .is_some_and(|d| {
+            ["omega", "angle_deg", "r", "frequency_hz"]
+                .iter()
+                .any(|k| d.contains_key(*k))
+        });
+    t.contains_key("run") || t.contains_key("expect") || drive_keys
 }
 
 /// Parses and checks the text of a rig file.

@@ -154,6 +154,7 @@ impl<T: Read + Write + Send> ReadWrite for T {}
 /// Opens a serial device at the link's speed, with a short read timeout, and drops whatever
 /// was waiting in its input (frames from before this connection).
 pub fn open_serial(path: &str) -> Result<Box<dyn serialport::SerialPort>> {
+    not_a_terminal(path)?;
     let port = serialport::new(path, BAUD)
         .timeout(Duration::from_millis(5))
         .open()
@@ -161,6 +162,45 @@ pub fn open_serial(path: &str) -> Result<Box<dyn serialport::SerialPort>> {
     port.clear(serialport::ClearBuffer::Input)
         .map_err(|e| Failure::new(Exit::NoRig, format!("{path}: cannot clear its input: {e}")))?;
     Ok(port)
+}
+
+/// Refuses a path that exists and is not a terminal device (a file, a FIFO, `/dev/null`): "not
+/// a serial port", before the serial layer's own words for it ("Not a typewriter"). A FIFO is
+/// never opened; a device is opened without blocking or becoming the controlling terminal.
+#[cfg(unix)]
+fn not_a_terminal(path: &str) -> Result<()> {
+    use std::os::fd::AsRawFd;
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    let what = if meta.file_type().is_char_device() {
+        let f = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
+            .open(path);
+        match f {
+            // SAFETY: isatty on a descriptor this function owns.
+            Ok(f) if unsafe { libc::isatty(f.as_raw_fd()) } == 0 => {
+                "a device that is not a terminal"
+            }
+            // A terminal, or an error the serial layer reports in its own words.
+            _ => return Ok(()),
+        }
+    } else if meta.is_dir() {
+        "a directory"
+    } else if meta.file_type().is_fifo() {
+        "a FIFO (named pipe)"
+    } else {
+        "a file"
+    };
+    anyhow::bail!("--port {path} is not a serial port ({what}); `kapitza ports` lists them")
+}
+
+#[cfg(not(unix))]
+fn not_a_terminal(_path: &str) -> Result<()> {
+    Ok(())
 }
 
 fn open_error(path: &str, e: serialport::Error) -> anyhow::Error {

@@ -54,7 +54,7 @@ pub struct SceneFile {
 /// Reads, overrides (`sets`: `KEY=VALUE` strings) and checks a scene file.
 pub fn load(path: &Path, sets: &[String]) -> Result<SceneFile> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).with_context(|| format!("{name}: cannot read"))?;
+    let text = crate::files::read_input("the scene file", path)?;
     let stem = path
         .file_stem()
         .map_or_else(|| name.clone(), |s| s.to_string_lossy().into_owned());

@@ -25,19 +25,29 @@ pub struct Args {
         value_name = "R,…",
         value_delimiter = ',',
         default_value = "0.8,1.2,1.75,2.5",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub r: Vec<f64>,
     #[command(flatten)]
     pub geometry: GeometryArgs,
     /// Drive amplitude A (m). With --rod or --point.
-    #[arg(long, value_name = "A", requires = "omega")]
+    #[arg(allow_hyphen_values = true, long, value_name = "A", requires = "omega")]
     pub amplitude: Option<f64>,
     /// Drive angular frequency ω (rad/s). With --rod or --point.
-    #[arg(long, value_name = "W", requires = "amplitude")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "W",
+        requires = "amplitude"
+    )]
     pub omega: Option<f64>,
     /// Gravity g (m/s²).
-    #[arg(long, value_name = "G", default_value_t = 9.81)]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "G",
+        default_value_t = 9.81
+    )]
     pub gravity: f64,
     /// Range of θd in degrees.
     #[arg(
@@ -48,7 +58,12 @@ pub struct Args {
     )]
     pub angle_range: Range,
     /// Samples of θd (both ends included).
-    #[arg(long, value_name = "N", default_value_t = 721)]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "N",
+        default_value_t = 721
+    )]
     pub samples: usize,
     #[command(flatten)]
     pub output: Output,

@@ -38,15 +38,23 @@ pub struct Args {
     #[arg(long, value_name = "KEY=FROM..TO", allow_hyphen_values = true)]
     pub y: Sweep,
     /// Cells NxM along x and y, both ends included.
-    #[arg(long, value_name = "NxM", default_value = "21x21")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "NxM",
+        default_value = "21x21"
+    )]
     pub size: Size,
     /// Further overrides applied to every cell (KEY=VALUE, as in `simulate --set`).
     #[arg(long, value_name = "KEY=VALUE")]
     pub set: Vec<String>,
     /// Compute only shard I of N (cells with index ≡ I mod N, I from 0) and write it to a file
     /// for `kapitza chart merge`.
-    #[arg(long, value_name = "I/N")]
+    #[arg(allow_hyphen_values = true, long, value_name = "I/N")]
     pub shard: Option<Shard>,
+    /// Run even when the estimated CPU time passes the budget (an hour).
+    #[arg(long)]
+    pub no_budget: bool,
     #[command(flatten)]
     pub output: Output,
 }
@@ -149,6 +157,17 @@ fn progress(n: u64) -> ProgressBar {
     bar
 }
 
+/// The run options of one cell.
+fn cell_options(file: &scene_file::SceneFile) -> Options {
+    Options {
+        method: file.method,
+        format: file.format,
+        out_dt: 0.0,
+        seed: file.seed,
+        ..Options::default()
+    }
+}
+
 /// Runs the cells of the shard (all cells without one).
 pub fn compute(args: &Args) -> Result<Map> {
     let name = args.scene.display().to_string();
@@ -168,20 +187,24 @@ pub fn compute(args: &Args) -> Result<Map> {
         sets
     };
     let base = scene_file::load(&args.scene, &cell_sets(0))?;
-    scene_file::load(&args.scene, &cell_sets(nx * ny - 1))?;
+    let last = scene_file::load(&args.scene, &cell_sets(nx * ny - 1))?;
+    // The cost of the map: its corner cells' pilot estimates, their mean for every cell.
+    let corners: Vec<f64> = [&base, &last]
+        .iter()
+        .filter_map(|f| crate::budget::simulation(&f.scene, &cell_options(f)))
+        .collect();
+    if !corners.is_empty() {
+        let cpu = corners.iter().sum::<f64>() / corners.len() as f64 * todo.len() as f64;
+        crate::budget::check(&format!("{name}: this map"), cpu, args.no_budget)?;
+        crate::budget::announce(&name, cpu);
+    }
     let bar = progress(todo.len() as u64);
     let cells = todo
         .par_iter()
         .map(|&c| -> Result<Cell> {
             let (i, j) = (c / ny, c % ny);
             let file = scene_file::load(&args.scene, &cell_sets(c))?;
-            let options = Options {
-                method: file.method,
-                format: file.format,
-                out_dt: 0.0,
-                seed: file.seed,
-                ..Options::default()
-            };
+            let options = cell_options(&file);
             let t = Instant::now();
             let mut share = Share::new(&bar);
             let report = simulate(&file.scene, &options, &mut share).map_err(|e| {

@@ -25,14 +25,19 @@ pub struct Args {
         value_name = "R,…",
         value_delimiter = ',',
         default_value = "1.2,1.5,1.75,1.9",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub r: Vec<f64>,
     /// Range of R drawn.
     #[arg(long, value_name = "FROM..TO", default_value = "0..3")]
     pub r_range: Range,
     /// Samples NxM of θd (0…180°) and R.
-    #[arg(long, value_name = "NxM", default_value = "361x301")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "NxM",
+        default_value = "361x301"
+    )]
     pub size: Size,
     #[command(flatten)]
     pub output: Output,

@@ -46,10 +46,15 @@ pub struct Args {
     )]
     pub m_range: Range,
     /// Samples NxM along x (k or ω) and y (m or A), both ends included.
-    #[arg(long, value_name = "NxM", default_value = "401x301")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "NxM",
+        default_value = "401x301"
+    )]
     pub size: Size,
     /// Quality factor Q = ω0/c of the damping (δ = √|k|/Q); undamped without it.
-    #[arg(long = "q", value_name = "Q", allow_negative_numbers = true)]
+    #[arg(long = "q", value_name = "Q", allow_hyphen_values = true)]
     pub quality: Option<f64>,
     /// Point(s) to mark, k,m (or ω,A in rad/s and metres with a pendulum). Repeatable.
     #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
@@ -63,13 +68,23 @@ pub struct Args {
     #[arg(long, value_name = "FROM..TO")]
     pub amplitude_range: Option<Range>,
     /// With a pendulum: the operating point's ω (rad/s), marked.
-    #[arg(long, value_name = "W", requires = "amplitude")]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "W",
+        requires = "amplitude"
+    )]
     pub omega: Option<f64>,
     /// With a pendulum: the operating point's A (m), marked.
-    #[arg(long, value_name = "A", requires = "omega")]
+    #[arg(allow_hyphen_values = true, long, value_name = "A", requires = "omega")]
     pub amplitude: Option<f64>,
     /// Gravity g (m/s²).
-    #[arg(long, value_name = "G", default_value_t = 9.81)]
+    #[arg(
+        allow_hyphen_values = true,
+        long,
+        value_name = "G",
+        default_value_t = 9.81
+    )]
     pub gravity: f64,
     /// With a pendulum: the hanging position (k > 0) instead of the inverted one.
     #[arg(long)]
@@ -315,6 +330,11 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         None => Damping::None,
     };
     let p = plane(args)?;
+    if let (Damping::Quality(q), Some(k_max)) =
+        (damping, p.ks.iter().map(|k| k.abs()).reduce(f64::max))
+    {
+        crate::input::quality_for("--q", q, k_max)?;
+    }
     if let (Some(w), Some(a)) = (args.omega, args.amplitude) {
         input::positive("--omega", w)?;
         input::non_negative("--amplitude", a)?;

@@ -18,12 +18,18 @@ pub(super) fn check_method(
         ));
     }
     let steps_ok = |spp: f64| spp > 0.0 && spp <= MAX_STEPS_PER_PERIOD;
+    // A fixed step longer than a drive period steps over the drive the full model integrates:
+    // its "outcome" describes no pendulum. The averaged model has no motion within a period.
+    let spans_periods = |spp: f64| fidelity != Fidelity::Averaged && spp < 1.0;
     match options.method {
         Method::Symplectic {
             steps_per_period, ..
         } => {
             if !steps_ok(steps_per_period) {
                 return Err(SimError::Unsupported(STEPS_PER_PERIOD_RANGE));
+            }
+            if spans_periods(steps_per_period) {
+                return Err(SimError::Unsupported(STEPS_SPAN_PERIODS));
             }
             if p.c > 0.0 || scene.effects.coulomb.is_some() {
                 return Err(SimError::Unsupported(
@@ -34,6 +40,9 @@ pub(super) fn check_method(
         Method::Rk4 { steps_per_period } => {
             if !steps_ok(steps_per_period) {
                 return Err(SimError::Unsupported(STEPS_PER_PERIOD_RANGE));
+            }
+            if spans_periods(steps_per_period) {
+                return Err(SimError::Unsupported(STEPS_SPAN_PERIODS));
             }
             if scene.effects.coulomb.is_some() {
                 return Err(SimError::Unsupported(
@@ -93,5 +102,6 @@ fn tolerances(rtol: f64, atol: f64) -> Result<(), SimError> {
 /// beyond it a run is a mistake that would take forever.
 const MAX_STEPS_PER_PERIOD: f64 = 1e6;
 const STEPS_PER_PERIOD_RANGE: &str = "run.steps_per_period must be a number > 0 and <= 1e6";
+const STEPS_SPAN_PERIODS: &str = "run.steps_per_period must be at least 1 on the full (or linearised) model: a fixed step spanning drive periods cannot follow the drive (fractions are allowed with fidelity = \"averaged\")";
 /// Output samples a run may write.
 const MAX_OUTPUT_SAMPLES: f64 = 1e9;
