@@ -6,7 +6,7 @@
 use kapitza_core::error::Compact;
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::rig::config::RigConfig;
-use kapitza_core::rig::fields::{self, Bound, End, BOUNDS};
+use kapitza_core::rig::fields::{self, Bound, End, Field, BOUNDS};
 
 /// One row of the table, for a person.
 #[derive(Debug, Clone, Copy)]
@@ -64,8 +64,8 @@ pub fn key(field: ConfigField) -> &'static str {
 }
 
 /// The unit and the reason of a table field.
-fn words(field: ConfigField) -> (&'static str, &'static str) {
-    use ConfigField as F;
+fn words(field: Field) -> (&'static str, &'static str) {
+    use Field as F;
     match field {
         F::LinkTimeoutMs => (
             "ms",
@@ -134,7 +134,6 @@ fn words(field: ConfigField) -> (&'static str, &'static str) {
             "the duty ceiling is a fraction of full duty: above 0 or the drive cannot run, \
              at most 1",
         ),
-        _ => ("", ""),
     }
 }
 
@@ -146,7 +145,7 @@ pub fn rows() -> Vec<Row> {
             let (unit, why) = words(b.field);
             Row {
                 bound: *b,
-                key: key(b.field),
+                key: key(b.field.into()),
                 unit,
                 why,
             }
@@ -170,14 +169,17 @@ pub fn range_text(b: &Bound) -> String {
 /// The range with its unit: `[500, 10000] ms`.
 fn range_with_unit(b: &Bound) -> String {
     match words(b.field).0 {
-        "" | "1" => range_text(b),
+        "1" => range_text(b),
         unit => format!("{} {unit}", range_text(b)),
     }
 }
 
 /// The range of a table field with its unit (`[500, 10000] ms`), for a refusal by the rig.
 pub fn allowed(field: ConfigField) -> Option<String> {
-    fields::bound(field).map(range_with_unit)
+    BOUNDS
+        .iter()
+        .find(|b| ConfigField::from(b.field) == field)
+        .map(range_with_unit)
 }
 
 /// The first table field of `cfg` outside its range, as a refusal that names the key the user
@@ -186,10 +188,10 @@ pub fn check(cfg: &RigConfig, typed: impl Fn(ConfigField) -> String) -> Result<(
     match fields::check(cfg) {
         Ok(()) => Ok(()),
         Err((field, value)) => {
-            let b = fields::bound(field).copied().unwrap_or(BOUNDS[0]);
+            let b = fields::bound(field);
             Err(format!(
                 "{} = {} is out of range: allowed {} ({})",
-                typed(field),
+                typed(field.into()),
                 Compact(value),
                 range_with_unit(&b),
                 words(field).1
@@ -220,30 +222,29 @@ mod tests {
 
     /// `cfg` with table field `f` set to `v` (a u32 field takes `v` rounded and saturated,
     /// as a TOML integer would be refused past u32 by the file's parser).
-    fn with(f: ConfigField, v: f64) -> RigConfig {
+    fn with(f: Field, v: f64) -> RigConfig {
         let mut c = RigConfig::REFERENCE;
         let l = &mut c.limits;
         let u = v.clamp(0.0, f64::from(u32::MAX)) as u32;
         match f {
-            ConfigField::LinkTimeoutMs => l.link_timeout_ms = u,
-            ConfigField::ControlHz => {
+            Field::LinkTimeoutMs => l.link_timeout_ms = u,
+            Field::ControlHz => {
                 c.control_hz = u;
                 // Keep the sample rate a multiple within its range where one exists.
                 c.sample_hz = (12_000 / u.max(1)).max(1) * u;
             }
-            ConfigField::SampleHz => c.sample_hz = u,
-            ConfigField::OmegaMax => l.omega_max = v,
-            ConfigField::OmegaRateMax => l.omega_rate_max = v,
-            ConfigField::DriveAngleMin => l.drive_angle_min_deg = v,
-            ConfigField::DriveAngleMax => l.drive_angle_max_deg = v,
-            ConfigField::DriveAngleRateMax => l.drive_angle_rate_max_deg = v,
-            ConfigField::CurrentMax => l.current_max = v,
-            ConfigField::OvercurrentMs => l.overcurrent_ms = u,
-            ConfigField::StallMinOmega => l.stall_min_omega = v,
-            ConfigField::StallFraction => l.stall_fraction = v,
-            ConfigField::StallMs => l.stall_ms = u,
-            ConfigField::DutyMax => l.duty_max = v,
-            other => panic!("{other:?} has no row"),
+            Field::SampleHz => c.sample_hz = u,
+            Field::OmegaMax => l.omega_max = v,
+            Field::OmegaRateMax => l.omega_rate_max = v,
+            Field::DriveAngleMin => l.drive_angle_min_deg = v,
+            Field::DriveAngleMax => l.drive_angle_max_deg = v,
+            Field::DriveAngleRateMax => l.drive_angle_rate_max_deg = v,
+            Field::CurrentMax => l.current_max = v,
+            Field::OvercurrentMs => l.overcurrent_ms = u,
+            Field::StallMinOmega => l.stall_min_omega = v,
+            Field::StallFraction => l.stall_fraction = v,
+            Field::StallMs => l.stall_ms = u,
+            Field::DutyMax => l.duty_max = v,
         }
         c
     }
@@ -261,13 +262,13 @@ mod tests {
     fn issue_23s_values_are_refused_by_name() {
         let key = |f| key(f).to_string();
         for (f, v, range) in [
-            (ConfigField::LinkTimeoutMs, 0.0, "[500, 10000] ms"),
-            (ConfigField::LinkTimeoutMs, 4_294_967_295.0, "[500, 10000] ms"),
-            (ConfigField::OvercurrentMs, 4_294_967_295.0, "[1, 1000] ms"),
-            (ConfigField::ControlHz, 5.0, "[100, 12000] Hz"),
+            (Field::LinkTimeoutMs, 0.0, "[500, 10000] ms"),
+            (Field::LinkTimeoutMs, 4_294_967_295.0, "[500, 10000] ms"),
+            (Field::OvercurrentMs, 4_294_967_295.0, "[1, 1000] ms"),
+            (Field::ControlHz, 5.0, "[100, 12000] Hz"),
         ] {
             let e = check(&with(f, v), key).unwrap_err();
-            assert!(e.starts_with(&format!("{} = ", super::key(f))), "{e}");
+            assert!(e.starts_with(&format!("{} = ", super::key(f.into()))), "{e}");
             assert!(e.contains(range), "{e}");
         }
     }
@@ -295,17 +296,20 @@ mod tests {
         fn inside_accepted_outside_refused((i, v) in row_and_value()) {
             let b = BOUNDS[i];
             let cfg = with(b.field, v);
-            let stored = fields::value(&cfg, b.field).unwrap();
+            let stored = fields::value(&cfg, b.field);
             let host = check(&cfg, |f| key(f).to_string());
             if b.admits(stored) {
                 prop_assert!(host.is_ok(), "{host:?}");
                 prop_assert!(fields::check(&cfg).is_ok());
             } else {
                 let e = host.unwrap_err();
-                prop_assert!(e.starts_with(key(b.field)), "{e}");
+                prop_assert!(e.starts_with(key(b.field.into())), "{e}");
                 prop_assert_eq!(fields::check(&cfg).unwrap_err().0, b.field);
                 let core = cfg.validate().unwrap_err();
-                prop_assert_eq!(ConfigField::from_param_name(core.name), b.field);
+                prop_assert_eq!(
+                    ConfigField::from_param_name(core.name),
+                    ConfigField::from(b.field)
+                );
             }
         }
     }

@@ -31,6 +31,7 @@
 //! The origin stays [`ConfigOrigin::Stored`]; the record is rewritten in the new format at the
 //! next accepted `SetConfig`. Any other version is [`Fallback::Incompatible`].
 
+pub mod repair;
 pub mod v1;
 pub mod v2;
 
@@ -41,7 +42,6 @@ use crate::checksum::CRC;
 use crate::link::reason::ConfigField;
 use crate::link::WireConfig;
 use crate::rig::config::RigConfig;
-use crate::rig::fields;
 
 /// "KPZC".
 pub const MAGIC: [u8; 4] = *b"KPZC";
@@ -119,14 +119,14 @@ fn payload<'a, T: Deserialize<'a>>(bytes: &'a [u8]) -> Result<T, Fallback> {
 
 /// The configuration to run on, and where it came from: the stored one if it is intact and
 /// valid; an intact one with fields out of range with those at their defaults and the rest
-/// (the calibration above all) kept ([`fields::repair`]); else the safe defaults with the
+/// (the calibration above all) kept ([`repair::repair`]); else the safe defaults with the
 /// reason.
 pub fn load(bytes: &[u8]) -> (RigConfig, ConfigOrigin) {
     let stored = match read(bytes) {
         Ok(c) => c,
         Err(f) => return (RigConfig::REFERENCE, ConfigOrigin::Defaults(f)),
     };
-    match fields::repair(stored) {
+    match repair::repair(stored) {
         Ok((c, defaulted)) if defaulted.is_empty() => (c, ConfigOrigin::Stored),
         Ok((c, defaulted)) => (c, ConfigOrigin::Repaired { defaulted }),
         Err(field) => (

@@ -339,12 +339,6 @@ pub fn reasons() -> Vec<(&'static str, Reason)> {
                 field: ConfigField::SampleHz,
             },
         ),
-        (
-            "refused_config_invalid_link_timeout",
-            Reason::ConfigInvalid {
-                field: ConfigField::LinkTimeoutMs,
-            },
-        ),
         ("refused_check_running", Reason::CheckRunning),
         (
             "refused_duty_above_cap",
