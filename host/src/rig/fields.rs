@@ -111,8 +111,8 @@ fn words(field: Field) -> (&'static str, &'static str) {
         ),
         F::OvercurrentMs => (
             "ms",
-            "how long the current may exceed current_max: at least one control tick, at most \
-             1 s so the trip still protects the bridge and the winding",
+            "how long the current may exceed current_max: at most 1 s, so the trip still \
+             protects the bridge and the winding",
         ),
         F::StallMinOmega => (
             "rad/s",
