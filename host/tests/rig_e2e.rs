@@ -459,7 +459,11 @@ fn a_limit_switched_off_is_refused_and_changes_nothing() {
     let before = kapitza(&["config", "get", "--port", port]);
     assert!(before.status.success());
     for (text, key, range) in [
-        ("[limits]\nlink_timeout_ms = 0\n", "limits.link_timeout_ms = 0", "[500, 10000] ms"),
+        (
+            "[limits]\nlink_timeout_ms = 0\n",
+            "limits.link_timeout_ms = 0",
+            "[500, 10000] ms",
+        ),
         (
             "[limits]\nlink_timeout_ms = 4294967295\n",
             "limits.link_timeout_ms = 4294967295",

@@ -7,11 +7,11 @@ use kapitza_core::link::message::{
     Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
     StopReason, Telemetry, Verdict, WireCalibration, WireClosedLoop, WireConfig, WireGeometry,
 };
+use kapitza_core::link::origin::FieldSet;
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{
     FrameReader, Reason, Request, Response, Status, VersionInfo, MAX_REQUEST_FRAME,
 };
-use kapitza_core::link::origin::FieldSet;
 use kapitza_core::persist::{self, ConfigOrigin, Fallback};
 use proptest::prelude::*;
 
@@ -232,7 +232,9 @@ fn check() -> impl Strategy<Value = Check> {
 fn origin() -> impl Strategy<Value = ConfigOrigin> {
     prop_oneof![
         Just(ConfigOrigin::Stored),
-        any::<u64>().prop_map(|bits| ConfigOrigin::Repaired { defaulted: FieldSet(bits) }),
+        any::<u64>().prop_map(|bits| ConfigOrigin::Repaired {
+            defaulted: FieldSet(bits)
+        }),
         Just(ConfigOrigin::Defaults(Fallback::Missing)),
         Just(ConfigOrigin::Defaults(Fallback::Corrupt)),
         any::<u16>().prop_map(|version| ConfigOrigin::Defaults(Fallback::Incompatible { version })),

@@ -386,7 +386,8 @@ mod server {
     #[test]
     fn the_rig_refuses_a_limit_switched_off_by_name() {
         use kapitza_core::link::reason::ConfigField as F;
-        let cases: [(F, fn(&mut WireConfig)); 6] = [
+        type Spoil = fn(&mut WireConfig);
+        let cases: [(F, Spoil); 6] = [
             (F::LinkTimeoutMs, |w| w.link_timeout_ms = 0),
             (F::LinkTimeoutMs, |w| w.link_timeout_ms = u32::MAX),
             (F::OvercurrentMs, |w| w.overcurrent_ms = u32::MAX),
@@ -405,7 +406,11 @@ mod server {
             spoil(&mut w);
             let before = s;
             let (r, e) = s.respond(Request::SetConfig(w), Clock::single(10, 0), false);
-            assert_eq!(r, Response::Refused(Reason::ConfigInvalid { field }), "{w:?}");
+            assert_eq!(
+                r,
+                Response::Refused(Reason::ConfigInvalid { field }),
+                "{w:?}"
+            );
             assert_eq!(e, Effect::None);
             assert_eq!((s.cfg, s.origin), (before.cfg, before.origin));
             assert_eq!(s.counters.commands, before.counters.commands);

@@ -268,7 +268,10 @@ mod tests {
             (Field::ControlHz, 5.0, "[100, 12000] Hz"),
         ] {
             let e = check(&with(f, v), key).unwrap_err();
-            assert!(e.starts_with(&format!("{} = ", super::key(f.into()))), "{e}");
+            assert!(
+                e.starts_with(&format!("{} = ", super::key(f.into()))),
+                "{e}"
+            );
             assert!(e.contains(range), "{e}");
         }
     }
@@ -286,7 +289,10 @@ mod tests {
     }
 
     fn row_and_value() -> impl Strategy<Value = (usize, f64)> {
-        (0..BOUNDS.len(), prop_oneof![any::<f64>(), -1e5..2e4f64, 0.0..1.0f64])
+        (
+            0..BOUNDS.len(),
+            prop_oneof![any::<f64>(), -1e5..2e4f64, 0.0..1.0f64],
+        )
     }
 
     proptest! {

@@ -95,9 +95,11 @@ pub fn line_failure(name: &str, e: Error) -> anyhow::Error {
     match e {
         Error::Refused(r) => {
             let range = match r {
-                kapitza_core::link::Reason::ConfigInvalid { field } => super::fields::allowed(field)
-                    .map(|a| format!(" ({}: allowed {a})", super::fields::key(field)))
-                    .unwrap_or_default(),
+                kapitza_core::link::Reason::ConfigInvalid { field } => {
+                    super::fields::allowed(field)
+                        .map(|a| format!(" ({}: allowed {a})", super::fields::key(field)))
+                        .unwrap_or_default()
+                }
                 _ => String::new(),
             };
             Failure::new(Exit::Refused, format!("the rig refused: {r}{range}")).into()
@@ -376,7 +378,8 @@ mod tests {
         );
         assert_eq!(json["config"], "stored, with fields at their defaults");
         assert!(
-            view.text().contains("at their defaults: limits.link_timeout_ms"),
+            view.text()
+                .contains("at their defaults: limits.link_timeout_ms"),
             "{}",
             view.text()
         );

@@ -43,7 +43,9 @@ impl FieldSet {
 
     /// The fields in the set, in [`ConfigField::ALL`]'s order.
     pub fn iter(self) -> impl Iterator<Item = ConfigField> {
-        ConfigField::ALL.into_iter().filter(move |&f| self.contains(f))
+        ConfigField::ALL
+            .into_iter()
+            .filter(move |&f| self.contains(f))
     }
 }
 

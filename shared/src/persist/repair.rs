@@ -91,7 +91,8 @@ pub fn repair(cfg: RigConfig) -> Result<(RigConfig, FieldSet), ConfigField> {
     for f in ConfigField::ALL {
         let mut c = stored;
         restore_default(&mut c, f);
-        let calibration = c.calibration != stored.calibration || c.closed_loop != stored.closed_loop;
+        let calibration =
+            c.calibration != stored.calibration || c.closed_loop != stored.closed_loop;
         if !calibration && !same(&c, &stored) {
             defaulted.insert(f);
         }
