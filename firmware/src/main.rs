@@ -56,6 +56,10 @@ async fn main(spawner: Spawner) {
     let (cfg, origin) = tasks::persist::load(&mut b.flash);
     match origin {
         ConfigOrigin::Stored => info!("configuration: stored"),
+        ConfigOrigin::Repaired { defaulted } => warn!(
+            "configuration: stored, fields out of range at their defaults ({=u64:#x})",
+            defaulted.0
+        ),
         other => warn!("configuration: safe defaults ({})", other),
     }
     // The sample rate, before any task can ask for it.

@@ -448,6 +448,53 @@ fn the_monitor_prints_records_from_a_served_rig() {
         .all(|r| r["mode"] == "idle" && r["settled"].is_boolean()));
 }
 
+/// Issue 23's configurations that switched a safety limit off: each is refused by `config set`
+/// with exit 1, naming the key typed and its range with its unit (the safety table,
+/// `kapitza_core::rig::fields`), and `config get` is unchanged afterwards.
+#[test]
+fn a_limit_switched_off_is_refused_and_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let rig = serve(&[]);
+    let port = rig.first_line.as_str();
+    let before = kapitza(&["config", "get", "--port", port]);
+    assert!(before.status.success());
+    for (text, key, range) in [
+        (
+            "[limits]\nlink_timeout_ms = 0\n",
+            "limits.link_timeout_ms = 0",
+            "[500, 10000] ms",
+        ),
+        (
+            "[limits]\nlink_timeout_ms = 4294967295\n",
+            "limits.link_timeout_ms = 4294967295",
+            "[500, 10000] ms",
+        ),
+        (
+            "[limits]\novercurrent_ms = 4294967295\n",
+            "limits.overcurrent_ms = 4294967295",
+            "[1, 1000] ms",
+        ),
+        (
+            "control_hz = 5\n[limits]\nomega_max = 15\nstall_min_omega = 10\n",
+            "control_hz = 5",
+            "[100, 12000] Hz",
+        ),
+    ] {
+        let file = dir.path().join("bad.toml");
+        std::fs::write(&file, text).unwrap();
+        let o = kapitza(&["config", "set", "--port", port, file.to_str().unwrap()]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{text}: {e}");
+        assert!(e.contains(key) && e.contains(range), "{text}: {e}");
+        assert!(e.contains("nothing was sent"), "{e}");
+        let after = kapitza(&["config", "get", "--port", port]);
+        assert_eq!(after.stdout, before.stdout, "{text}");
+    }
+    let s = json(&kapitza(&["status", "--port", port, "--json"]));
+    assert_eq!(s["config"], "stored");
+    assert_eq!(s["config_fallbacks"], serde_json::json!([]));
+}
+
 #[test]
 fn configuration_round_trip_and_refusal_by_field() {
     let dir = tempfile::tempdir().unwrap();
@@ -467,7 +514,11 @@ fn configuration_round_trip_and_refusal_by_field() {
     let o = kapitza(&["config", "set", "--port", port, bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(1));
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("stall_fraction") && e.contains("(0, 1]"), "{e}");
+    // The safety table's row (kapitza_core::rig::fields): stall_fraction in [0.05, 0.9].
+    assert!(
+        e.contains("limits.stall_fraction = 3") && e.contains("[0.05, 0.9]"),
+        "{e}"
+    );
     // A partial file: only the amplitude changes.
     let new = dir.path().join("new.toml");
     std::fs::write(&new, "amplitude = 0.012\n").unwrap();

@@ -7,6 +7,7 @@ use kapitza_core::link::message::{
     Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
     StopReason, Telemetry, Verdict, WireCalibration, WireClosedLoop, WireConfig, WireGeometry,
 };
+use kapitza_core::link::origin::FieldSet;
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{
     FrameReader, Reason, Request, Response, Status, VersionInfo, MAX_REQUEST_FRAME,
@@ -48,10 +49,12 @@ fn mode() -> impl Strategy<Value = Mode> {
 fn field() -> impl Strategy<Value = ConfigField> {
     prop_oneof![
         Just(ConfigField::Amplitude),
-        Just(ConfigField::Rates),
+        Just(ConfigField::SampleHz),
         Just(ConfigField::CrankSign),
         Just(ConfigField::ClosedLoopRateMax),
         Just(ConfigField::ConnectingRod),
+        Just(ConfigField::LinkTimeoutMs),
+        Just(ConfigField::DriveAngleMax),
         Just(ConfigField::Other),
     ]
 }
@@ -229,6 +232,9 @@ fn check() -> impl Strategy<Value = Check> {
 fn origin() -> impl Strategy<Value = ConfigOrigin> {
     prop_oneof![
         Just(ConfigOrigin::Stored),
+        any::<u64>().prop_map(|bits| ConfigOrigin::Repaired {
+            defaulted: FieldSet(bits)
+        }),
         Just(ConfigOrigin::Defaults(Fallback::Missing)),
         Just(ConfigOrigin::Defaults(Fallback::Corrupt)),
         any::<u16>().prop_map(|version| ConfigOrigin::Defaults(Fallback::Incompatible { version })),
@@ -513,7 +519,11 @@ proptest! {
         // A damaged record is never taken as stored, unless the byte hit was padding.
         let used = 8 + usize::from(u16::from_le_bytes([buf[6], buf[7]])) + 4;
         if i < used {
-            prop_assert!(origin != ConfigOrigin::Stored);
+            prop_assert!(
+                !matches!(origin, ConfigOrigin::Stored | ConfigOrigin::Repaired { .. }),
+                "{:?}",
+                origin
+            );
         }
     }
 }

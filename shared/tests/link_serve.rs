@@ -298,7 +298,7 @@ fn reasons_read_well() {
     let w: kapitza_core::link::WireConfig = c.into();
     assert_eq!(
         w.to_valid().unwrap_err().to_string(),
-        "[23] configuration value sample_hz/control_hz out of range"
+        "[23] configuration value sample_hz out of range"
     );
     assert_eq!(
         kapitza_core::link::WireConfig::from(CFG).to_valid(),
@@ -379,6 +379,44 @@ mod server {
                 kapitza_core::link::message::Verdict::Aborted
             ))
         );
+    }
+
+    /// Issue 23's configurations that switched a safety limit off, sent as `SetConfig` straight
+    /// to the rig (no host check): each is refused naming its field, and nothing changes.
+    #[test]
+    fn the_rig_refuses_a_limit_switched_off_by_name() {
+        use kapitza_core::link::reason::ConfigField as F;
+        type Spoil = fn(&mut WireConfig);
+        let cases: [(F, Spoil); 6] = [
+            (F::LinkTimeoutMs, |w| w.link_timeout_ms = 0),
+            (F::LinkTimeoutMs, |w| w.link_timeout_ms = u32::MAX),
+            (F::OvercurrentMs, |w| w.overcurrent_ms = u32::MAX),
+            (F::ControlHz, |w| {
+                // 5 Hz with an ω_max below π·5 (the aliasing bound) and a stall speed below it.
+                w.control_hz = 5;
+                w.omega_max = 15.0;
+                w.stall_min_omega = 10.0;
+            }),
+            (F::StallMs, |w| w.stall_ms = u32::MAX),
+            (F::DutyMax, |w| w.duty_max = 0.0),
+        ];
+        for (field, spoil) in cases {
+            let mut s = server();
+            let mut w: WireConfig = CFG.into();
+            spoil(&mut w);
+            let before = s;
+            let (r, e) = s.respond(Request::SetConfig(w), Clock::single(10, 0), false);
+            assert_eq!(
+                r,
+                Response::Refused(Reason::ConfigInvalid { field }),
+                "{w:?}"
+            );
+            assert_eq!(e, Effect::None);
+            assert_eq!((s.cfg, s.origin), (before.cfg, before.origin));
+            assert_eq!(s.counters.commands, before.counters.commands);
+            let (r, _) = s.respond(Request::GetConfig, Clock::single(20, 0), false);
+            assert_eq!(r, Response::Config(CFG.into()));
+        }
     }
 
     #[test]

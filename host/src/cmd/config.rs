@@ -18,7 +18,7 @@ use kapitza_core::rig::servo::ServoMap;
 use serde::{Deserialize, Serialize};
 
 use super::rig_args::RigArgs;
-use crate::rig::{Exit, Failure};
+use crate::rig::{fields, Exit, Failure};
 
 #[derive(Debug, clap::Subcommand)]
 pub enum Action {
@@ -301,8 +301,10 @@ pub fn read(file: &std::path::Path, current: &RigConfig) -> Result<RigConfig> {
     merge(&mut table, over);
     let parsed: ConfigFile = serde_path_to_error::deserialize(toml::Value::Table(table))
         .map_err(|e| anyhow!("{}: {e}", file.display()))?;
-    RigConfig::from(&parsed)
-        .validate()
+    let cfg = RigConfig::from(&parsed);
+    fields::check(&cfg, |f| fields::key(f).to_string())
+        .map_err(|e| anyhow!("{}: {e}; nothing was sent", file.display()))?;
+    cfg.validate()
         .map_err(|e| anyhow!("{}: {e}; nothing was sent", file.display()))
 }
 

@@ -445,6 +445,13 @@ fn convert(raw: RawRig) -> Result<RigFile> {
         cl.band = l.band.unwrap_or(cl.band);
         cl.rate_max = l.rate_max.unwrap_or(cl.rate_max);
     }
+    // Of the safety table's fields a rig file sets only the duty ceiling; the rest are the
+    // reference's.
+    super::fields::check(&config, |f| match f {
+        kapitza_core::link::reason::ConfigField::DutyMax => "configured.duty_max".into(),
+        f => super::fields::key(f).into(),
+    })
+    .map_err(|e| anyhow!("{e}"))?;
     let config = config.validate().map_err(|e| anyhow!("configured: {e}"))?;
     if amplitude > 0.1 * ell {
         bail!("drive.amplitude = {amplitude} is too large for the pendulum");
@@ -510,5 +517,25 @@ mod tests {
         let e = parse("[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\nspeed = 3\n")
             .unwrap_err();
         assert!(format!("{e:#}").contains("speed"), "{e:#}");
+    }
+
+    #[test]
+    fn a_duty_ceiling_outside_the_safety_table_is_refused_by_its_key() {
+        // The table's duty_max row: (0, 1] (rig::fields::BOUNDS).
+        for d in ["0", "1.5", "-0.2"] {
+            let e = parse(&format!(
+                "[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n\
+                 [configured]\nduty_max = {d}\n"
+            ))
+            .unwrap_err();
+            let e = format!("{e:#}");
+            assert!(e.contains(&format!("configured.duty_max = {d}")), "{e}");
+            assert!(e.contains("allowed (0, 1]"), "{e}");
+        }
+        let ok = parse(
+            "[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n\
+             [configured]\nduty_max = 1\n",
+        );
+        assert!(ok.is_ok(), "{ok:?}");
     }
 }

@@ -4,6 +4,7 @@
 //! | module | concept |
 //! |---|---|
 //! | [`port`] | `--port`: a device, `auto` (the one ST-LINK), `sim`; listing ports; opening one |
+//! | [`fields`] | the core's safety table with each field's key, unit and reason: the checks before sending, `config_fallbacks`, docs/rig.md's table |
 //! | [`file`] | rig files: a simulated rig's true physics and the configuration it is given |
 //! | [`simhost`] | a simulated rig against the wall clock (real time × speed), on any line |
 //! | [`predicted`] | what the model expects of the configured pendulum at a drive (the `predict` code) |
@@ -14,6 +15,7 @@
 //! Exit statuses of the rig commands: 0 done, 1 refused, 2 usage, 3 no rig / the line failed,
 //! 4 `--wait` timed out ([`Exit`]).
 
+pub mod fields;
 pub mod file;
 pub mod names;
 pub mod owner;

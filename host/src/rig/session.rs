@@ -93,7 +93,17 @@ pub fn check_version(version: &VersionInfo, name: &str) -> Result<()> {
 /// A failed call in terms of its exit status: refused (1) or the line (3).
 pub fn line_failure(name: &str, e: Error) -> anyhow::Error {
     match e {
-        Error::Refused(r) => Failure::new(Exit::Refused, format!("the rig refused: {r}")).into(),
+        Error::Refused(r) => {
+            let range = match r {
+                kapitza_core::link::Reason::ConfigInvalid { field } => {
+                    super::fields::allowed(field)
+                        .map(|a| format!(" ({}: allowed {a})", super::fields::key(field)))
+                        .unwrap_or_default()
+                }
+                _ => String::new(),
+            };
+            Failure::new(Exit::Refused, format!("the rig refused: {r}{range}")).into()
+        }
         Error::Invalid(what) => Failure::new(Exit::Refused, format!("cannot send: {what}")).into(),
         Error::Line(LineError::VersionMismatch(r)) => Failure::new(
             Exit::NoRig,
@@ -172,6 +182,9 @@ pub struct StatusView {
     pub commands: u32,
     /// Where the rig's configuration came from.
     pub config: String,
+    /// The stored configuration's fields that were out of range and run at their defaults
+    /// (their `config get` keys); empty when none did.
+    pub config_fallbacks: Vec<&'static str>,
     pub uptime_s: f64,
     /// Why the rig last reset (`"power_on"`, `"pin"`, `"watchdog"`, `"software"`, `"other"`),
     /// and the fault latched before that reset, or null.
@@ -228,9 +241,16 @@ impl StatusView {
             commands: s.counters.commands,
             config: match s.config {
                 ConfigOrigin::Stored => "stored".into(),
+                ConfigOrigin::Repaired { .. } => "stored, with fields at their defaults".into(),
                 ConfigOrigin::Received { saved: true } => "received, saved".into(),
                 ConfigOrigin::Received { saved: false } => "received, not saved".into(),
                 ConfigOrigin::Defaults(f) => format!("safe defaults ({f:?})"),
+            },
+            config_fallbacks: match s.config {
+                ConfigOrigin::Repaired { defaulted } => {
+                    defaulted.iter().map(super::fields::key).collect()
+                }
+                _ => Vec::new(),
             },
             uptime_s: f64::from(s.uptime_ms) / 1000.0,
             reset_cause: reset_name(&s.reset.cause),
@@ -319,6 +339,49 @@ impl StatusView {
             if self.estop { "PRESSED" } else { "released" },
             self.config
         );
+        if !self.config_fallbacks.is_empty() {
+            s += &format!(
+                "\nconfig      stored out of range, running at their defaults: {} \
+                 (`kapitza config set` to store new values)",
+                self.config_fallbacks.join(", ")
+            );
+        }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kapitza_core::persist;
+    use kapitza_core::rig::fixed::Angle;
+    use kapitza_core::station::serve::{Clock, RigServer};
+
+    /// A record stored with `link_timeout_ms = 0` boots with that field at its default and
+    /// the calibration kept; the status names it in `config_fallbacks` and in its text.
+    #[test]
+    fn a_repaired_record_lists_its_fallbacks() {
+        let mut stored = RigConfig::REFERENCE;
+        stored.calibration.pendulum_zero = 999;
+        stored.limits.link_timeout_ms = 0;
+        let mut buf = [0u8; persist::RECORD_MAX];
+        persist::encode(&stored, &mut buf);
+        let (cfg, origin) = persist::load(&buf);
+        assert_eq!(cfg.calibration.pendulum_zero, 999);
+        assert_eq!(cfg.limits.link_timeout_ms, 1000);
+        let rig = RigServer::new(cfg, origin, Angle::ZERO, Clock::single(0, 0), [0, 1, 0]);
+        let view = StatusView::new(&rig.status(false, 0), None, &cfg);
+        let json = serde_json::to_value(&view).unwrap();
+        assert_eq!(
+            json["config_fallbacks"],
+            serde_json::json!(["limits.link_timeout_ms"])
+        );
+        assert_eq!(json["config"], "stored, with fields at their defaults");
+        assert!(
+            view.text()
+                .contains("at their defaults: limits.link_timeout_ms"),
+            "{}",
+            view.text()
+        );
     }
 }

@@ -109,6 +109,12 @@ impl From<safety::Refusal> for Reason {
     }
 }
 
+impl From<crate::rig::fields::Field> for ConfigField {
+    fn from(f: crate::rig::fields::Field) -> Self {
+        Self::from_param_name(f.name())
+    }
+}
+
 impl From<ParamError> for Reason {
     fn from(e: ParamError) -> Self {
         Self::ConfigInvalid {

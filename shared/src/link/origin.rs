@@ -21,12 +21,44 @@ pub enum Fallback {
     Invalid { field: ConfigField },
 }
 
+/// A set of configuration fields, one bit per [`ConfigField`] (bit `field as u32`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FieldSet(pub u64);
+
+impl FieldSet {
+    pub const EMPTY: Self = Self(0);
+
+    pub fn contains(self, f: ConfigField) -> bool {
+        self.0 & (1 << f as u32) != 0
+    }
+
+    pub fn insert(&mut self, f: ConfigField) {
+        self.0 |= 1 << f as u32;
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The fields in the set, in [`ConfigField::ALL`]'s order.
+    pub fn iter(self) -> impl Iterator<Item = ConfigField> {
+        ConfigField::ALL
+            .into_iter()
+            .filter(move |&f| self.contains(f))
+    }
+}
+
 /// Where the configuration in use came from (reported in the status).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ConfigOrigin {
     /// Loaded from flash at power-up.
     Stored,
+    /// Loaded from flash at power-up, but these fields were out of range: they run at their
+    /// safe defaults ([`crate::rig::config::RigConfig::REFERENCE`]'s), the rest (the calibration
+    /// above all) as stored.
+    Repaired { defaulted: FieldSet },
     /// The stored one was unusable: running on the safe defaults ([`crate::rig::config::RigConfig::REFERENCE`]).
     Defaults(Fallback),
     /// Set over the link since power-up; `saved` says whether it reached flash.

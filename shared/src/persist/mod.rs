@@ -12,9 +12,11 @@
 //! ```
 //! [`load`] never fails: an erased page (all 0xFF) is [`Fallback::Missing`]; a wrong magic,
 //! length or CRC is [`Fallback::Corrupt`]; another format version is [`Fallback::Incompatible`];
-//! a record whose numbers [`RigConfig::validate`] refuses is [`Fallback::Invalid`]. In each case
-//! the rig runs on [`RigConfig::REFERENCE`] (the safe defaults) and the status says why
-//! ([`ConfigOrigin::Defaults`]). Bump [`RECORD_VERSION`] whenever [`WireConfig`]'s encoding
+//! a record whose numbers [`RigConfig::validate`] refuses is [`Fallback::Invalid`] to
+//! [`decode`]. In each case [`load`] runs the rig on [`RigConfig::REFERENCE`] (the safe
+//! defaults) and the status says why ([`ConfigOrigin::Defaults`]), but for an intact record
+//! with fields out of range: those take their defaults, the rest (the calibration above all) is
+//! kept, and the status lists them ([`ConfigOrigin::Repaired`]). Bump [`RECORD_VERSION`] whenever [`WireConfig`]'s encoding
 //! changes (the link's golden frames catch that).
 //!
 //! **Migration.** A record of an older format that this firmware still reads loads as the
@@ -29,6 +31,7 @@
 //! The origin stays [`ConfigOrigin::Stored`]; the record is rewritten in the new format at the
 //! next accepted `SetConfig`. Any other version is [`Fallback::Incompatible`].
 
+pub mod repair;
 pub mod v1;
 pub mod v2;
 
@@ -69,6 +72,14 @@ pub fn encode(cfg: &RigConfig, out: &mut [u8; RECORD_MAX]) -> usize {
 /// The configuration stored in `bytes` (a flash page, or any prefix of it that holds the
 /// record), checked, or why it cannot be used.
 pub fn decode(bytes: &[u8]) -> Result<RigConfig, Fallback> {
+    let cfg = read(bytes)?;
+    cfg.validate().map_err(|e| Fallback::Invalid {
+        field: ConfigField::from_param_name(e.name),
+    })
+}
+
+/// The configuration stored in `bytes`, intact but not yet checked.
+fn read(bytes: &[u8]) -> Result<RigConfig, Fallback> {
     let head = bytes.get(..HEAD).ok_or(Fallback::Corrupt)?;
     if head.iter().all(|&b| b == 0xFF) {
         return Err(Fallback::Missing);
@@ -90,14 +101,11 @@ pub fn decode(bytes: &[u8]) -> Result<RigConfig, Fallback> {
     if CRC.checksum(body) != u32::from_le_bytes([crc[0], crc[1], crc[2], crc[3]]) {
         return Err(Fallback::Corrupt);
     }
-    let cfg = match version {
+    Ok(match version {
         1 => RigConfig::from(payload::<v1::ConfigV1>(&body[HEAD..])?),
         2 => RigConfig::from(payload::<v2::ConfigV2>(&body[HEAD..])?),
         RECORD_VERSION => RigConfig::from(payload::<WireConfig>(&body[HEAD..])?),
         _ => return Err(Fallback::Incompatible { version }),
-    };
-    cfg.validate().map_err(|e| Fallback::Invalid {
-        field: ConfigField::from_param_name(e.name),
     })
 }
 
@@ -110,11 +118,21 @@ fn payload<'a, T: Deserialize<'a>>(bytes: &'a [u8]) -> Result<T, Fallback> {
 }
 
 /// The configuration to run on, and where it came from: the stored one if it is intact and
-/// valid, else the safe defaults with the reason.
+/// valid; an intact one with fields out of range with those at their defaults and the rest
+/// (the calibration above all) kept ([`repair::repair`]); else the safe defaults with the
+/// reason.
 pub fn load(bytes: &[u8]) -> (RigConfig, ConfigOrigin) {
-    match decode(bytes) {
-        Ok(c) => (c, ConfigOrigin::Stored),
-        Err(f) => (RigConfig::REFERENCE, ConfigOrigin::Defaults(f)),
+    let stored = match read(bytes) {
+        Ok(c) => c,
+        Err(f) => return (RigConfig::REFERENCE, ConfigOrigin::Defaults(f)),
+    };
+    match repair::repair(stored) {
+        Ok((c, defaulted)) if defaulted.is_empty() => (c, ConfigOrigin::Stored),
+        Ok((c, defaulted)) => (c, ConfigOrigin::Repaired { defaulted }),
+        Err(field) => (
+            RigConfig::REFERENCE,
+            ConfigOrigin::Defaults(Fallback::Invalid { field }),
+        ),
     }
 }
 
@@ -167,18 +185,77 @@ mod tests {
         let crc = CRC.checksum(&buf[..HEAD + n]);
         buf[HEAD + n..HEAD + n + 4].copy_from_slice(&crc.to_le_bytes());
         assert_eq!(decode(&buf), Err(Fallback::Incompatible { version: 4 }));
-        // Intact but out of range.
+        // Intact but out of range: refused by `decode`, repaired by `load`.
         let mut bad = RigConfig::REFERENCE;
         bad.gravity = -1.0;
         encode(&bad, &mut buf);
         assert_eq!(
-            load(&buf),
-            (
-                RigConfig::REFERENCE,
-                ConfigOrigin::Defaults(Fallback::Invalid {
-                    field: ConfigField::Gravity
-                })
-            )
+            decode(&buf),
+            Err(Fallback::Invalid {
+                field: ConfigField::Gravity
+            })
         );
+        let mut defaulted = crate::link::origin::FieldSet::EMPTY;
+        defaulted.insert(ConfigField::Gravity);
+        assert_eq!(
+            load(&buf),
+            (RigConfig::REFERENCE, ConfigOrigin::Repaired { defaulted })
+        );
+    }
+
+    /// A record stored before the safety table (issue 23's `link_timeout_ms = 0` and
+    /// `overcurrent_ms = 4294967295`) loads with those two at their defaults and the rest as
+    /// stored: the calibration, the stall time and the stroke.
+    #[test]
+    fn a_stored_field_out_of_range_takes_its_default_and_keeps_the_calibration() {
+        let mut stored = RigConfig::REFERENCE;
+        stored.amplitude = 0.0125;
+        stored.calibration.pendulum_zero = 4321;
+        stored.calibration.crank_sign = -1;
+        stored.calibration.servo.centre_deg = 85.0;
+        stored.limits.stall_ms = 400;
+        stored.limits.link_timeout_ms = 0;
+        stored.limits.overcurrent_ms = u32::MAX;
+        let mut buf = [0u8; RECORD_MAX];
+        encode(&stored, &mut buf);
+        let (cfg, origin) = load(&buf);
+        let mut want = stored;
+        want.limits.link_timeout_ms = RigConfig::REFERENCE.limits.link_timeout_ms;
+        want.limits.overcurrent_ms = RigConfig::REFERENCE.limits.overcurrent_ms;
+        assert_eq!(cfg, want);
+        assert_eq!(cfg.calibration, stored.calibration);
+        let ConfigOrigin::Repaired { defaulted } = origin else {
+            panic!("{origin:?}");
+        };
+        let got: Vec<_> = defaulted.iter().collect();
+        assert_eq!(
+            got,
+            [ConfigField::OvercurrentMs, ConfigField::LinkTimeoutMs]
+        );
+    }
+
+    /// A control rate of 5 Hz takes its default of 1 kHz; then the stored sample rate, no
+    /// multiple of it, is refused and takes its own: each refused field in turn, the
+    /// calibration and ω_max kept.
+    #[test]
+    fn fields_refused_together_are_repaired_in_turn() {
+        let mut stored = RigConfig::REFERENCE;
+        stored.calibration.pendulum_zero = 77;
+        stored.control_hz = 5;
+        stored.limits.omega_max = 15.0;
+        stored.limits.stall_min_omega = 10.0;
+        stored.sample_hz = 2_500;
+        let mut buf = [0u8; RECORD_MAX];
+        encode(&stored, &mut buf);
+        let (cfg, origin) = load(&buf);
+        assert_eq!(cfg.calibration, stored.calibration);
+        assert_eq!(cfg.control_hz, 1_000);
+        assert_eq!(cfg.sample_hz, 10_000);
+        assert_eq!(cfg.limits.omega_max, 15.0);
+        let ConfigOrigin::Repaired { defaulted } = origin else {
+            panic!("{origin:?}");
+        };
+        let got: Vec<_> = defaulted.iter().collect();
+        assert_eq!(got, [ConfigField::SampleHz, ConfigField::ControlHz]);
     }
 }

@@ -137,6 +137,10 @@ impl RigConfig {
 
     /// Checks every number once; the rest of the rig logic relies on it.
     pub fn validate(self) -> Result<Self, ParamError> {
+        // The safety ranges first (rig::fields): a refusal names the field the table names.
+        if let Err((field, value)) = super::fields::check(&self) {
+            return Err(too_big(field.name(), value, SAFETY_RANGE));
+        }
         positive("amplitude", self.amplitude)?;
         positive("gravity", self.gravity)?;
         // The expansion A cos ψ + (A²/4b) cos 2ψ needs b well past the crank radius; below 2A
@@ -187,6 +191,14 @@ impl RigConfig {
                 "omega_max",
                 l.omega_max,
                 "below pi*control_hz, where the crank speed measurement aliases",
+            ));
+        }
+        // A stall detector that arms only above the highest speed never arms.
+        if l.stall_min_omega >= l.omega_max {
+            return Err(too_big(
+                "stall_min_omega",
+                l.stall_min_omega,
+                "below omega_max (else the stall detector never arms)",
             ));
         }
         positive("omega_rate_max", l.omega_rate_max)?;
@@ -301,6 +313,9 @@ impl RigConfig {
     }
 }
 
+/// What a refusal by the safety table allows; the host says the range itself.
+const SAFETY_RANGE: &str = "the range in docs/rig.md, \"Safety limits\"";
+
 /// The end of the I16F16 range (RadPerSec, Amps, Ratio).
 const Q16_MAX: f64 = 32_768.0;
 
@@ -371,7 +386,8 @@ mod tests {
             assert_eq!(c.validate().is_ok(), ok, "{hz}");
         }
         let mut c = RigConfig::REFERENCE;
-        c.limits.drive_angle_min_deg = 200.0;
+        c.limits.drive_angle_min_deg = 170.0;
+        c.limits.drive_angle_max_deg = 160.0;
         assert_eq!(c.validate().unwrap_err().name, "drive_angle_max_deg");
         for d in [0.0, -0.5, 1.01, f64::NAN] {
             let mut c = RigConfig::REFERENCE;

@@ -9,6 +9,7 @@
 //! |---|---|
 //! | [`fixed`] | Q-format aliases, the wrapping [`fixed::Angle`], and every approximation (sin/cos, ln, sqrt, division) with its tested error bound |
 //! | [`config`] | the rig configuration — stroke A, pendulum geometry, limits — as one type; R ↔ ω |
+//! | [`fields`] | the safety range of each configuration field that guards the rig: numbers only |
 //! | [`calibration`] | the bench's measured constants in the configuration: sensor zero and signs, servo map, current sense, estimator thresholds |
 //! | [`closed_loop`] | the settings of closing the loop on R (carried and stored) |
 //! | [`dds`] | the drive-phase accumulator: exact integer phase, rate-limited phase-continuous frequency changes, soft start and stop |
@@ -41,6 +42,7 @@ pub mod controller;
 pub mod dds;
 pub mod estimator;
 pub mod estop;
+pub mod fields;
 pub mod fixed;
 pub mod phase_lock;
 pub mod r_trim;

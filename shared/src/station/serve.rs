@@ -365,7 +365,8 @@ impl RigServer {
     /// A new configuration: valid, and the rig idle; the rig restarts on it with θd kept. A
     /// change of closed-loop R alone is taken in any mode.
     /// The one already in use and in flash is accepted as it is (`None`: nothing to store, so
-    /// a repeated `SetConfig` never wears the flash page).
+    /// a repeated `SetConfig` never wears the flash page); a repaired one is stored, so the
+    /// flash holds what the rig runs on.
     fn set_config(&mut self, w: WireConfig, at: Clock) -> Result<Option<RigConfig>, Reason> {
         let cfg = w.to_valid()?;
         let in_flash = matches!(

@@ -5,6 +5,7 @@ use kapitza_core::link::message::{
     Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
     StopReason, Telemetry, Verdict, VersionInfo, WireConfig, WireGeometry,
 };
+use kapitza_core::link::origin::FieldSet;
 use kapitza_core::link::reason::ConfigField;
 use kapitza_core::link::{Reason, Request, Response, Status};
 use kapitza_core::persist::{ConfigOrigin, Fallback};
@@ -335,7 +336,7 @@ pub fn reasons() -> Vec<(&'static str, Reason)> {
         (
             "refused_config_invalid",
             Reason::ConfigInvalid {
-                field: ConfigField::Rates,
+                field: ConfigField::SampleHz,
             },
         ),
         ("refused_check_running", Reason::CheckRunning),
@@ -370,6 +371,23 @@ pub fn origins() -> Vec<(&'static str, ConfigOrigin)> {
             "status_config_invalid_crank_sign",
             ConfigOrigin::Defaults(Fallback::Invalid {
                 field: ConfigField::CrankSign,
+            }),
+        ),
+        (
+            "status_config_repaired",
+            ConfigOrigin::Repaired {
+                defaulted: {
+                    let mut d = FieldSet::EMPTY;
+                    d.insert(ConfigField::LinkTimeoutMs);
+                    d.insert(ConfigField::OvercurrentMs);
+                    d
+                },
+            },
+        ),
+        (
+            "status_config_invalid_control_hz",
+            ConfigOrigin::Defaults(Fallback::Invalid {
+                field: ConfigField::ControlHz,
             }),
         ),
         (
