@@ -366,8 +366,9 @@ fn through_an_owner_a_signal_and_a_stop_reach_the_rig() {
 fn a_superseded_wait_exits_5_naming_the_new_target() {
     let dir = tempfile::tempdir().unwrap();
     let truth = dir.path().join("truth.jsonl");
-    // Real time: the drive ramps for seconds before it can settle.
-    let (_rig, port) = serve("1", &truth);
+    // A quarter of real time: the drive ramps and settles for tens of seconds of wall time, so
+    // the second command comes first however loaded the machine.
+    let (_rig, port) = serve("0.25", &truth);
     let mut owner = Proc::start(&["attach", "--port", &port]);
     assert!(owner.first_line().starts_with("attached"));
     let wait = Proc::start(&[

@@ -71,6 +71,8 @@ pub fn active(st: &Status) -> bool {
 #[derive(Default)]
 pub struct Driving {
     seen: bool,
+    /// The last status showed a start's pre-run check running.
+    checking: bool,
 }
 
 impl Driving {
@@ -81,6 +83,11 @@ impl Driving {
                 crate::rig::names::fault_name(&f)
             );
         }
+        // A start's check that fails after it ran: its verdict, not someone else's stop.
+        if let (true, Some(Check::Failed(why))) = (self.checking, st.check) {
+            anyhow::bail!("the drive did not start: the pre-run check failed: {why}");
+        }
+        self.checking = st.check == Some(Check::Running);
         let on = active(st);
         if self.seen && !on {
             return Err(Halt::StoppedElsewhere.into());

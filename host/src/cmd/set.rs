@@ -18,7 +18,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 use kapitza_core::link::message::{Check, Mode};
+use kapitza_core::link::convert::from_q16;
 use kapitza_core::link::Telemetry;
+use kapitza_core::rig::config::RigConfig;
 
 use super::progress::progress_writer;
 use super::rig_args::RigArgs;
@@ -108,7 +110,10 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     }
     let st = s.call(|c| c.status())?;
     let after = st.counters.commands;
-    let ours = Target::of(&st);
+    let ours = Target {
+        r: args.r,
+        theta_d_deg: args.angle,
+    };
     let mut progress = progress_writer(args.json, &mut *out);
     writeln!(
         progress,
@@ -163,34 +168,30 @@ fn await_check(s: &mut Session) -> Result<Result<(), String>> {
     }
 }
 
-/// The drive's target as the status gives it (ω and θd, I16F16): another command's `set`
-/// changes it.
+/// The drive's target this command asked for; another command's `set` changes the status's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Target {
-    omega: i32,
-    theta_d_deg: i32,
+    r: f64,
+    theta_d_deg: f64,
 }
 
-impl Target {
-    fn of(st: &kapitza_core::link::Status) -> Self {
-        Self {
-            omega: st.omega_target,
-            theta_d_deg: st.theta_d_target_deg,
-        }
-    }
+/// How far the status's target may lie from the one asked for and still be it: the link's
+/// I16F16 ω and θd round to 1.5e-5 (relative 1e-6 in R at ω ≈ 30 rad/s and above).
+const SAME_R: f64 = 1e-4;
+const SAME_DEG: f64 = 1e-3;
 
-    /// Whether `now` is another command's target rather than this one's. With closed-loop R
-    /// on, the rig trims ω itself within the configuration's band (in R).
-    fn replaced_by(&self, now: &Self, cfg: &kapitza_core::rig::config::RigConfig) -> bool {
-        use kapitza_core::link::convert::from_q16;
-        if now.theta_d_deg != self.theta_d_deg {
-            return true;
-        }
-        if !cfg.closed_loop.enabled {
-            return now.omega != self.omega;
-        }
-        let r = |w: i32| cfg.r_for_omega(from_q16(w));
-        (r(now.omega) - r(self.omega)).abs() > cfg.closed_loop.band
+impl Target {
+    /// Whether the status `st` carries another command's target rather than this one. With
+    /// closed-loop R on, the rig trims ω itself within the configuration's band (in R).
+    fn replaced_by(&self, st: &kapitza_core::link::Status, cfg: &RigConfig) -> bool {
+        let r = cfg.r_for_omega(from_q16(st.omega_target));
+        let deg = from_q16(st.theta_d_target_deg);
+        let band = if cfg.closed_loop.enabled {
+            cfg.closed_loop.band.max(SAME_R)
+        } else {
+            SAME_R
+        };
+        (deg - self.theta_d_deg).abs() > SAME_DEG || (r - self.r).abs() > band
     }
 }
 
@@ -267,19 +268,7 @@ fn follow(
         if Instant::now() >= next_alive {
             next_alive = Instant::now() + KEEP_ALIVE;
             let st = s.call(|c| c.status())?;
-            let now = Target::of(&st);
-            if now.omega != 0 && ours.replaced_by(&now, &s.config) {
-                let v = StatusView::new(&st, None, &s.config);
-                return Err(Failure::new(
-                    Exit::Superseded,
-                    format!(
-                        "{}: superseded by another command's R = {:.3} at θd = {:.1}° before \
-                         the pendulum settled",
-                        s.name, v.r_target, v.drive_angle_target_deg
-                    ),
-                )
-                .into());
-            }
+            superseded(s, &st, ours)?;
             if let Mode::Faulted(_) | Mode::Idle = st.mode {
                 let v = StatusView::new(&st, None, &s.config);
                 let why = v.fault.or(v.last_stop).unwrap_or("stopped");
@@ -305,9 +294,30 @@ fn follow(
             next_line = Instant::now() + PROGRESS_EVERY;
         }
         if t.settled && deadline.is_some() {
+            // Settled, but at whose target: the status says.
+            let st = s.call(|c| c.status())?;
+            superseded(s, &st, ours)?;
             return Ok(true);
         }
     }
+}
+
+/// Exit 5 when the status's target is another command's: a new drive, not a stop (a stop
+/// from elsewhere ends the wait as a stopped drive).
+fn superseded(s: &Session, st: &kapitza_core::link::Status, ours: Target) -> Result<()> {
+    if st.omega_target != 0 && ours.replaced_by(st, &s.config) {
+        let v = StatusView::new(st, None, &s.config);
+        return Err(Failure::new(
+            Exit::Superseded,
+            format!(
+                "{}: superseded by another command's R = {:.3} at θd = {:.1}° before the \
+                 pendulum settled",
+                s.name, v.r_target, v.drive_angle_target_deg
+            ),
+        )
+        .into());
+    }
+    Ok(())
 }
 
 /// What the drive and the estimator are doing.
@@ -324,7 +334,6 @@ fn stage(t: &Telemetry) -> &'static str {
 /// One line of what the rig does.
 fn progress_line(t: &Telemetry) -> String {
     use crate::rig::names::turns_deg;
-    use kapitza_core::link::convert::from_q16;
     let phi = match (t.settled, t.equilibrium) {
         (true, Some(e)) => turns_deg(e),
         _ => turns_deg(t.phi),
