@@ -5,6 +5,7 @@
 //! process's end) with a generous deadline: these are not timed tests.
 
 use std::io::{BufRead, BufReader, Read};
+use std::sync::mpsc::{self, Receiver};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::thread::JoinHandle;
@@ -24,11 +25,11 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A running `kapitza` with both of its streams collected; its first stdout line read when
-/// asked. Killed when dropped.
+/// A running `kapitza` with both of its streams read as they come (a full pipe never blocks
+/// it); its stdout line by line. Killed when dropped.
 struct Proc {
     child: Child,
-    out: BufReader<std::process::ChildStdout>,
+    out: Receiver<String>,
     err: Option<JoinHandle<String>>,
 }
 
@@ -49,7 +50,15 @@ impl Proc {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        let out = BufReader::new(child.stdout.take().unwrap());
+        let stdout = BufReader::new(child.stdout.take().unwrap());
+        let (tx, out) = mpsc::channel();
+        std::thread::spawn(move || {
+            for l in stdout.lines().map_while(Result::ok) {
+                if tx.send(l).is_err() {
+                    return;
+                }
+            }
+        });
         let mut err = child.stderr.take().unwrap();
         let err = std::thread::spawn(move || {
             let mut s = String::new();
@@ -63,9 +72,9 @@ impl Proc {
         }
     }
 
+    /// The next line of stdout (at most 60 s of wall time; a panic after that).
     fn first_line(&mut self) -> String {
-        let mut l = String::new();
-        self.out.read_line(&mut l).unwrap();
+        let l = self.out.recv_timeout(Duration::from_secs(60)).unwrap();
         l.trim().to_string()
     }
 
@@ -84,8 +93,7 @@ impl Proc {
             assert!(Instant::now() < deadline, "still running after {secs} s");
             std::thread::sleep(Duration::from_millis(10));
         };
-        let mut stdout = String::new();
-        let _ = self.out.read_to_string(&mut stdout);
+        let stdout: String = self.out.iter().map(|l| l + "\n").collect();
         Ended {
             code: status.code(),
             stdout,
