@@ -234,8 +234,7 @@ impl<'a> Calibrator<'a> {
         self.op
             .say("crank: the crank encoder's direction, from a short pulse")?;
         self.idle()?;
-        self
-            .ask("the crank will turn for 0.3 s at low duty: keep clear of it")?;
+        self.ask("the crank will turn for 0.3 s at low duty: keep clear of it")?;
         let deg = self.theta_d_now()?;
         self.s.call(|c| c.stream_telemetry(20))?;
         self.s.call(|c| c.bring_up(PULSE_DUTY, deg))?;
@@ -274,14 +273,18 @@ impl<'a> Calibrator<'a> {
         self.s.call(|c| c.bring_up(0.0, deg))?;
         // At rest: from the first frame after which the crank encoder stood still for REST_S.
         let mut still: Option<(u32, f64)> = None;
-        let (frames, _) =
-            record::raw_until(&mut self.s, &mut self.watch, REST_S + SPIN_DOWN_S, |f, t| match still {
+        let (frames, _) = record::raw_until(
+            &mut self.s,
+            &mut self.watch,
+            REST_S + SPIN_DOWN_S,
+            |f, t| match still {
                 Some((crank, since)) if crank == f.crank => t - since >= REST_S,
                 _ => {
                     still = Some((f.crank, t));
                     false
                 }
-            })?;
+            },
+        )?;
         let since = still.map_or(0.0, |(_, since)| since);
         let readings: Vec<f64> = frames
             .iter()
@@ -424,14 +427,15 @@ impl<'a> Calibrator<'a> {
         self.s.call(|c| c.stream_telemetry(20))?;
         self.s.call(|c| c.set_drive(STROKE_R, STROKE_DEG))?;
         let mut quiet_since: Option<f64> = None;
-        let (frames, settled) = record::telemetry(&mut self.s, &mut self.watch, STROKE_TIMEOUT_S, |t, now| {
-            if t.settled && t.steady && t.equilibrium.is_some() {
-                now - *quiet_since.get_or_insert(now) >= STROKE_QUIET_S
-            } else {
-                quiet_since = None;
-                false
-            }
-        })?;
+        let (frames, settled) =
+            record::telemetry(&mut self.s, &mut self.watch, STROKE_TIMEOUT_S, |t, now| {
+                if t.settled && t.steady && t.equilibrium.is_some() {
+                    now - *quiet_since.get_or_insert(now) >= STROKE_QUIET_S
+                } else {
+                    quiet_since = None;
+                    false
+                }
+            })?;
         self.idle()?;
         if !settled {
             bail!(

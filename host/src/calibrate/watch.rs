@@ -46,7 +46,10 @@ impl Watch {
             return Err(Halt::Signal(sig).into());
         }
         if let Some(sv) = self.served.as_mut() {
-            if sv.serve(&mut s.client).map_err(|e| line_failure(&s.name, e))? {
+            if sv
+                .serve(&mut s.client)
+                .map_err(|e| line_failure(&s.name, e))?
+            {
                 return Err(Halt::StoppedElsewhere.into());
             }
         }

@@ -168,9 +168,15 @@ fn ended(
     );
     match halt {
         Some(Halt::Signal(sig)) if confirmed => sig.failure(what),
-        Some(Halt::Signal(sig)) => Failure::new(Exit::NoRig, format!("{}: {what}", sig.name())).into(),
+        Some(Halt::Signal(sig)) => {
+            Failure::new(Exit::NoRig, format!("{}: {what}", sig.name())).into()
+        }
         Some(Halt::StoppedElsewhere) => Failure::new(
-            if confirmed { Exit::Refused } else { Exit::NoRig },
+            if confirmed {
+                Exit::Refused
+            } else {
+                Exit::NoRig
+            },
             format!(
                 "the drive was stopped from elsewhere (`kapitza stop`, the monitor's s, or the \
                  rig itself): {what}"

@@ -17,8 +17,8 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
-use kapitza_core::link::message::{Check, Mode};
 use kapitza_core::link::convert::from_q16;
+use kapitza_core::link::message::{Check, Mode};
 use kapitza_core::link::Telemetry;
 use kapitza_core::rig::config::RigConfig;
 

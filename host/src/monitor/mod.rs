@@ -233,10 +233,7 @@ fn tui_loop(s: &mut Session, terminal: &mut ratatui::DefaultTerminal, stay: bool
             }
         }
         let finished = s.driver.as_ref().is_some_and(|d| d.finished());
-        if s.state.quit
-            || crate::signals::caught().is_some()
-            || (s.done() && !(stay && finished))
-        {
+        if s.state.quit || crate::signals::caught().is_some() || (s.done() && !(stay && finished)) {
             return Ok(());
         }
     }
