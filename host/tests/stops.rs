@@ -478,3 +478,39 @@ fn the_monitor_on_sigterm_stops_the_drive_and_exits_0() {
     );
     await_truth(&truth, 10, "the stop", stopped);
 }
+
+/// Whether `pid` catches `sig` (Linux: the SigCgt mask in /proc): its handlers are installed.
+fn catches(pid: u32, sig: i32) -> bool {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigCgt:"))
+        .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+        .is_some_and(|m| m & (1 << (sig - 1)) != 0)
+}
+
+#[test]
+fn a_model_command_ends_at_once_with_the_signals_status() {
+    // 10⁷ drive periods of the full model: about a minute of work (10⁵ take 0.7 s), never
+    // finished here.
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/horizontal-r1.75.toml"
+    );
+    for (sig, code) in [
+        (libc::SIGINT, 130),
+        (libc::SIGTERM, 143),
+        (libc::SIGHUP, 129),
+    ] {
+        let p = Proc::start(&["simulate", scene, "--set", "run.periods=10000000", "--json"]);
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while !catches(p.child.id(), sig) {
+            assert!(Instant::now() < deadline, "no handler for {sig}");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        p.signal(sig);
+        let end = p.wait(10);
+        assert_eq!(end.code, Some(code), "signal {sig}: {}", end.stderr);
+        assert!(!end.stdout.contains("outcome"), "{}", end.stdout);
+    }
+}
