@@ -73,18 +73,20 @@ impl Signal {
     }
 }
 
-fn handled() -> Vec<i32> {
-    let mut v = vec![signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM];
-    #[cfg(unix)]
-    v.push(signal_hook::consts::SIGHUP);
-    v
-}
+#[cfg(unix)]
+const HANDLED: [i32; 3] = [
+    signal_hook::consts::SIGINT,
+    signal_hook::consts::SIGTERM,
+    signal_hook::consts::SIGHUP,
+];
+#[cfg(not(unix))]
+const HANDLED: [i32; 2] = [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM];
 
 /// Installs the handlers (once): until [`catch`], a signal ends the process at once with its
 /// status.
 pub fn install() {
     INSTALL.call_once(|| {
-        for n in handled() {
+        for n in HANDLED {
             // SAFETY: the action only touches atomics and calls _exit, both async-signal-safe.
             let _ = unsafe {
                 signal_hook::low_level::register(n, move || {
