@@ -15,6 +15,7 @@
 //! | [`input`] | checks of command-line numbers |
 //! | [`link`] | the serial-link client: one method per command; "the line failed" apart from "the rig refused" |
 //! | [`monitor`] | the live monitor: feeds, state machine, dashboard, JSON/CSV records |
+//! | [`signals`] | SIGINT, SIGTERM, SIGHUP: which arrived, so a command stops the drive, then exits 130/143/129 |
 //! | [`scene_file`] | scene files (TOML) and `--set` → the core's `Scene`, run options, `[expect]` |
 //! | [`outcome`] | the simulator's verdict in user terms, and `[expect]` judged against it |
 //! | [`record`] | what a run keeps for the output files, and its progress bar |
@@ -41,6 +42,7 @@ pub mod plot;
 pub mod record;
 pub mod rig;
 pub mod scene_file;
+pub mod signals;
 pub mod timing;
 
 pub use cli::run;

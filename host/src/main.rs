@@ -2,6 +2,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    kapitza::signals::install();
     let mut out = std::io::stdout().lock();
     match kapitza::run(std::env::args_os(), &mut out) {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,6 +7,7 @@
 //! | [`record`] | sensor streams over the link for a stretch of rig time, the link kept alive |
 //! | [`steps`] | the steps: what each asks of the person, measures, refuses and changes |
 //! | [`operator`] | the person at the rig: prompts, confirmations, `--yes` |
+//! | [`watch`] | what ends a step early: a signal, a stop from elsewhere; the socket served |
 //!
 //! ```text
 //! sensor    ring-down in bring-up mode (motor off): direction from the counter-clockwise
@@ -19,11 +20,13 @@
 //!           lean gives the mount's true angle                  → servo centre (without marks)
 //! ```
 //! The configuration is written after every step that passed, so later steps run on what the
-//! earlier ones found; the one the rig had before is saved to a file first.
+//! earlier ones found; the one the rig had before is saved to a file first. A step ended early
+//! (a signal, `kapitza stop`, the monitor's `s`) stops the drive and writes nothing.
 
 pub mod operator;
 pub mod record;
 pub mod steps;
+pub mod watch;
 
 use serde::Serialize;
 

@@ -1,10 +1,13 @@
 //! The person at the rig: what a step asks them to do, and their answer. With `--yes` nothing
 //! is waited for (a simulated rig's hand, `kapitza_core::simrig::hand`, does the lifting);
-//! without it a line on stdin confirms, and `q` stops the calibration.
+//! without it a line on stdin confirms, and `q` stops the calibration. Lines are read on a
+//! thread of their own, so a signal or a stop from elsewhere is seen while a prompt waits.
 
 use std::io::{BufRead, IsTerminal, Write};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::Duration;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 
 pub struct Operator<'a> {
     /// Go on without asking.
@@ -13,33 +16,56 @@ pub struct Operator<'a> {
     pub plain: bool,
     /// Where prompts and progress go (stdout, or stderr under `--json`).
     pub out: &'a mut dyn Write,
+    /// Lines from stdin, once the first is asked for.
+    lines: Option<Receiver<std::io::Result<String>>>,
 }
 
-impl Operator<'_> {
-    /// Says what to do, and waits for Enter unless `--yes`.
-    pub fn ask(&mut self, what: &str) -> Result<()> {
+impl<'a> Operator<'a> {
+    pub fn new(yes: bool, plain: bool, out: &'a mut dyn Write) -> Self {
+        Self {
+            yes,
+            plain,
+            out,
+            lines: None,
+        }
+    }
+
+    /// Says what to do; returns whether an answer is awaited (not with `--yes`).
+    pub fn ask(&mut self, what: &str) -> Result<bool> {
         if self.plain {
             writeln!(self.out, "do: {what}")?;
         } else {
             writeln!(self.out, "  → {what}")?;
         }
         if self.yes {
-            return Ok(());
+            return Ok(false);
         }
         write!(self.out, "    press Enter when done (q to stop): ")?;
         self.out.flush()?;
-        let line = self.line()?;
-        if line.trim() == "q" {
-            bail!("calibration stopped at the prompt; nothing more was changed");
-        }
-        Ok(())
+        Ok(true)
     }
 
-    /// A line typed by the person (empty at end of input).
-    pub fn line(&mut self) -> Result<String> {
-        let mut s = String::new();
-        std::io::stdin().lock().read_line(&mut s)?;
-        Ok(s)
+    /// A line typed by the person if one arrives within `wait` (empty at end of input).
+    pub fn poll_line(&mut self, wait: Duration) -> Result<Option<String>> {
+        self.out.flush()?;
+        let lines = self.lines.get_or_insert_with(|| {
+            let (tx, rx) = mpsc::channel();
+            std::thread::spawn(move || loop {
+                let mut s = String::new();
+                let r = std::io::stdin().lock().read_line(&mut s);
+                let end = !matches!(r, Ok(n) if n > 0);
+                if tx.send(r.map(|_| s)).is_err() || end {
+                    return;
+                }
+            });
+            rx
+        });
+        match lines.recv_timeout(wait) {
+            Ok(r) => Ok(Some(r?)),
+            Err(RecvTimeoutError::Timeout) => Ok(None),
+            // At end of input every line is empty.
+            Err(RecvTimeoutError::Disconnected) => Ok(Some(String::new())),
+        }
     }
 
     /// Whether a person can answer: not `--yes`, and stdin is a terminal.

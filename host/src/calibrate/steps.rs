@@ -15,6 +15,7 @@ use kapitza_core::rig::fixed::Angle;
 
 use super::operator::Operator;
 use super::record;
+use super::watch::Watch;
 use super::{Step, StepReport};
 use crate::rig::session::Session;
 use crate::rig::{Exit, Failure};
@@ -44,6 +45,10 @@ const STROKE_R: f64 = 0.5;
 const STROKE_DEG: f64 = 90.0;
 const STROKE_QUIET_S: f64 = 3.0;
 const STROKE_TIMEOUT_S: f64 = 90.0;
+/// Waiting for a typed line: the signals and the socket looked at this often, and the link
+/// kept alive (well inside the rig's link timeout).
+const LINE_POLL: Duration = Duration::from_millis(20);
+const LINE_KEEP_ALIVE: Duration = Duration::from_millis(200);
 /// The marks a person jogs the mount to (degrees), those inside the travel.
 const MARKS: [f64; 3] = [0.0, 90.0, 180.0];
 
@@ -52,6 +57,8 @@ pub struct Calibrator<'a> {
     pub s: Session,
     pub op: Operator<'a>,
     pub cfg: RigConfig,
+    /// Signals, stops from elsewhere, and the control socket while this command owns the port.
+    pub watch: Watch,
     /// The ring-down of this run (the sensor step's serves the ringdown step: ℓ, Q and μ do
     /// not depend on the sensor's zero or direction).
     ring: Option<ringdown::RingDown>,
@@ -71,12 +78,13 @@ fn refused(step: Step, e: CalibError) -> anyhow::Error {
 }
 
 impl<'a> Calibrator<'a> {
-    pub fn new(s: Session, op: Operator<'a>) -> Self {
+    pub fn new(s: Session, op: Operator<'a>, watch: Watch) -> Self {
         let cfg = s.config;
         Self {
             s,
             op,
             cfg,
+            watch,
             ring: None,
             marked: false,
         }
@@ -111,6 +119,7 @@ impl<'a> Calibrator<'a> {
         self.s.call(|c| c.stop())?;
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
+            self.watch.tick(&mut self.s)?;
             let st = self.s.call(|c| c.status())?;
             match st.mode {
                 Mode::Idle if st.bring_up.is_none() => return Ok(()),
@@ -127,6 +136,33 @@ impl<'a> Calibrator<'a> {
         }
     }
 
+    /// Says what to do and, unless `--yes`, waits for Enter (`q` stops the calibration).
+    fn ask(&mut self, what: &str) -> Result<()> {
+        if !self.op.ask(what)? {
+            return Ok(());
+        }
+        if self.line()?.trim() == "q" {
+            bail!("calibration stopped at the prompt; nothing more was changed");
+        }
+        Ok(())
+    }
+
+    /// A line typed by the person (empty at end of input), the link kept alive and the
+    /// [`Watch`] asked meanwhile.
+    fn line(&mut self) -> Result<String> {
+        let mut alive = Instant::now();
+        loop {
+            if let Some(l) = self.op.poll_line(LINE_POLL)? {
+                return Ok(l);
+            }
+            self.watch.tick(&mut self.s)?;
+            if alive.elapsed() >= LINE_KEEP_ALIVE {
+                self.s.call(|c| c.status())?;
+                alive = Instant::now();
+            }
+        }
+    }
+
     fn theta_d_now(&mut self) -> Result<f64> {
         Ok(from_q16(self.s.call(|c| c.status())?.theta_d_deg))
     }
@@ -135,14 +171,14 @@ impl<'a> Calibrator<'a> {
     /// from the release on, and the angle it was held at.
     fn record_ring_down(&mut self) -> Result<(Vec<f64>, Vec<f64>)> {
         self.idle()?;
-        self.op.ask(
+        self.ask(
             "hold the pendulum still about 20° counter-clockwise (seen from the front); \
              after you confirm, let go and keep clear for 25 s",
         )?;
         let deg = self.theta_d_now()?;
         self.s.call(|c| c.stream_telemetry(20))?;
         self.s.call(|c| c.bring_up(0.0, deg))?;
-        let frames = record::raw(&mut self.s, RING_S + 2.0)?;
+        let frames = record::raw(&mut self.s, &mut self.watch, RING_S + 2.0)?;
         self.idle()?;
         let mut t = Vec::with_capacity(frames.len());
         let mut x = Vec::with_capacity(frames.len());
@@ -198,12 +234,11 @@ impl<'a> Calibrator<'a> {
         self.op
             .say("crank: the crank encoder's direction, from a short pulse")?;
         self.idle()?;
-        self.op
-            .ask("the crank will turn for 0.3 s at low duty: keep clear of it")?;
+        self.ask("the crank will turn for 0.3 s at low duty: keep clear of it")?;
         let deg = self.theta_d_now()?;
         self.s.call(|c| c.stream_telemetry(20))?;
         self.s.call(|c| c.bring_up(PULSE_DUTY, deg))?;
-        let frames = record::raw(&mut self.s, PULSE_S)?;
+        let frames = record::raw(&mut self.s, &mut self.watch, PULSE_S)?;
         self.idle()?;
         let counts: Vec<u32> = frames
             .iter()
@@ -238,14 +273,18 @@ impl<'a> Calibrator<'a> {
         self.s.call(|c| c.bring_up(0.0, deg))?;
         // At rest: from the first frame after which the crank encoder stood still for REST_S.
         let mut still: Option<(u32, f64)> = None;
-        let (frames, _) =
-            record::raw_until(&mut self.s, REST_S + SPIN_DOWN_S, |f, t| match still {
+        let (frames, _) = record::raw_until(
+            &mut self.s,
+            &mut self.watch,
+            REST_S + SPIN_DOWN_S,
+            |f, t| match still {
                 Some((crank, since)) if crank == f.crank => t - since >= REST_S,
                 _ => {
                     still = Some((f.crank, t));
                     false
                 }
-            })?;
+            },
+        )?;
         let since = still.map_or(0.0, |(_, since)| since);
         let readings: Vec<f64> = frames
             .iter()
@@ -281,7 +320,7 @@ impl<'a> Calibrator<'a> {
                     "  jog the mount's blade onto the {mark}° mark: type a drive angle in \
                      degrees to move there (now {at:.2}°), Enter alone when it is on the mark"
                 ))?;
-                let line = self.op.line()?;
+                let line = self.line()?;
                 let line = line.trim();
                 if line.is_empty() {
                     break;
@@ -295,8 +334,6 @@ impl<'a> Calibrator<'a> {
                         lim.drive_angle_min_deg, lim.drive_angle_max_deg
                     ))?,
                 }
-                // Keep the link alive while the person types.
-                self.s.call(|c| c.status())?;
             }
             marks.push(servo_fit::Mark {
                 pulse_us: f64::from(map.pulse_us(at)),
@@ -383,21 +420,22 @@ impl<'a> Calibrator<'a> {
                 .to_string()
         })?;
         self.idle()?;
-        self.op.ask(&format!(
+        self.ask(&format!(
             "the drive will run at R = {STROKE_R}, θd = {STROKE_DEG}° for about 20 s with the \
              pendulum hanging: keep clear"
         ))?;
         self.s.call(|c| c.stream_telemetry(20))?;
         self.s.call(|c| c.set_drive(STROKE_R, STROKE_DEG))?;
         let mut quiet_since: Option<f64> = None;
-        let (frames, settled) = record::telemetry(&mut self.s, STROKE_TIMEOUT_S, |t, now| {
-            if t.settled && t.steady && t.equilibrium.is_some() {
-                now - *quiet_since.get_or_insert(now) >= STROKE_QUIET_S
-            } else {
-                quiet_since = None;
-                false
-            }
-        })?;
+        let (frames, settled) =
+            record::telemetry(&mut self.s, &mut self.watch, STROKE_TIMEOUT_S, |t, now| {
+                if t.settled && t.steady && t.equilibrium.is_some() {
+                    now - *quiet_since.get_or_insert(now) >= STROKE_QUIET_S
+                } else {
+                    quiet_since = None;
+                    false
+                }
+            })?;
         self.idle()?;
         if !settled {
             bail!(

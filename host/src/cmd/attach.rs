@@ -8,11 +8,12 @@ use anyhow::Result;
 use super::rig_args::RigArgs;
 use crate::rig::owner::{Event, Owner};
 use crate::rig::session::StatusView;
-use crate::rig::{self};
+use crate::rig::{self, Exit, Failure};
 
 /// Own the rig's port and keep its link alive, so a drive outlives the commands that set it:
 /// `kapitza set`, `status`, `stop` in other terminals go through this process's control
-/// socket. Prints a line whenever the rig's mode changes. Ctrl-C stops the drive and exits.
+/// socket. Prints a line whenever the rig's mode changes. Ctrl-C (or SIGTERM, SIGHUP) stops the
+/// drive and exits: 0 once the rig confirmed the stop, 3 if it did not.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -69,11 +70,12 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     if owner.shutdown() {
         writeln!(out, "detached; the rig confirmed the stop")?;
     } else {
-        writeln!(
-            out,
+        return Err(Failure::new(
+            Exit::NoRig,
             "detached; the rig did not confirm the stop: it stops by itself once the line has \
-             been silent for its link timeout (link_timeout_ms, 1 s unless configured)"
-        )?;
+             been silent for its link timeout (link_timeout_ms, 1 s unless configured)",
+        )
+        .into());
     }
     Ok(())
 }

@@ -5,6 +5,13 @@
 //! file (`--backup FILE`, never over an existing one unless `--force`; default a new file in the
 //! backup folder, [`backup_dir`]), as `kapitza config get` prints it; `kapitza config set FILE`
 //! restores it.
+//!
+//! Without an owner of the port running, calibrate is its owner while it runs: it serves the
+//! control socket, so `kapitza stop` and `status` work from another terminal (`set` and
+//! `config set` are refused: calibration in progress). With an owner running it goes through
+//! it. A signal (SIGINT, SIGTERM, SIGHUP) or a stop from elsewhere ends the step at once: the
+//! drive is stopped, nothing from that step is written, and a signal exits 130 / 143 / 129
+//! (3 when the rig did not confirm the stop).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -16,9 +23,12 @@ use super::progress::progress_writer;
 use super::rig_args::RigArgs;
 use crate::calibrate::operator::Operator;
 use crate::calibrate::steps::Calibrator;
+use crate::calibrate::watch::{Halt, Watch};
 use crate::calibrate::{Step, StepReport};
 use crate::files;
-use crate::rig;
+use crate::rig::port::Target;
+use crate::rig::served::Served;
+use crate::rig::{self, Exit, Failure};
 
 /// Calibrate the rig: pendulum sensor direction and zero, crank direction, servo map and
 /// current offset, the pendulum's length and damping from a ring-down, the stroke from the fast
@@ -109,6 +119,9 @@ struct Summary<'a> {
     steps: &'a [StepReport],
 }
 
+/// What `set` and `config set` are told while calibrate owns the port.
+pub const BUSY: &str = "calibration in progress (`kapitza calibrate` owns the port)";
+
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let existing = files::Existing::from_flags(args.force, false);
     if let Some(p) = &args.backup {
@@ -117,8 +130,13 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         backup_dir()?;
     }
     rig::catch_interrupt();
+    let target = args.rig.target()?;
     let s = args.rig.connect()?;
     let name = s.name.clone();
+    let served = match &target {
+        Target::Serial { path } if !s.via_owner => Some(Served::open(path, BUSY)?),
+        _ => None,
+    };
     let (mut file, backup) = match &args.backup {
         Some(p) => (files::create_output("--backup", p, existing)?, p.clone()),
         None => new_default_backup()?,
@@ -134,23 +152,31 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         "{name}: the configuration it had is saved to {} (restore: `{restore}`)",
         backup.display()
     )?;
-    let op = Operator {
-        yes: args.yes,
-        plain: args.plain,
-        out: &mut *progress,
-    };
-    let mut cal = Calibrator::new(s, op);
+    if let Some(p) = served.as_ref().map(Served::socket) {
+        writeln!(
+            progress,
+            "{name}: owned by this calibration; `kapitza stop` and `kapitza status` work from \
+             another terminal (control socket {})",
+            p.display()
+        )?;
+    }
+    let op = Operator::new(args.yes, args.plain, &mut *progress);
+    let mut cal = Calibrator::new(s, op, Watch { served });
     let steps: Vec<Step> = match args.step {
         Some(s) => vec![s],
         None => Step::ALL.to_vec(),
     };
-    let mut reports = Vec::new();
+    let mut reports: Vec<StepReport> = Vec::new();
     for step in steps {
-        if rig::interrupted() {
-            anyhow::bail!("interrupted; the steps before were written");
-        }
-        let r = cal.run(step)?;
-        cal.write()?;
+        let r = match cal
+            .watch
+            .tick(&mut cal.s)
+            .and_then(|()| cal.run(step))
+            .and_then(|r| cal.write().map(|()| r))
+        {
+            Ok(r) => r,
+            Err(e) => return Err(ended(&mut cal, step, &reports, &restore, e)),
+        };
         cal.op.say(&r.text())?;
         reports.push(r);
     }
@@ -169,4 +195,57 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         writeln!(out, "{}", serde_json::to_string_pretty(&summary)?)?;
     }
     Ok(())
+}
+
+/// A step that did not finish: the drive stopped first (a stop is accepted in every mode), then
+/// the error with what was stored, and the exit status a signal or an unconfirmed stop calls
+/// for.
+fn ended(
+    cal: &mut Calibrator,
+    step: Step,
+    stored: &[StepReport],
+    restore: &str,
+    e: anyhow::Error,
+) -> anyhow::Error {
+    let confirmed = cal.s.client.stop().is_ok();
+    let before = if stored.is_empty() {
+        "nothing was stored".to_string()
+    } else {
+        let names: Vec<&str> = stored.iter().map(|r| r.step.label()).collect();
+        format!(
+            "the steps before it were stored ({}; `{restore}` goes back)",
+            names.join(", ")
+        )
+    };
+    let stop = if confirmed {
+        "the drive is stopped (the rig confirmed the stop)"
+    } else {
+        "the rig did not confirm the stop: it stops by itself once the line has been silent \
+         for its link timeout (link_timeout_ms, 1 s unless configured)"
+    };
+    let halt = e.downcast_ref::<Halt>().copied();
+    let what = format!(
+        "calibration ended in the {} step: {stop}; nothing from this step was written; {before}",
+        step.label()
+    );
+    match halt {
+        Some(Halt::Signal(sig)) if confirmed => sig.failure(what),
+        Some(Halt::Signal(sig)) => {
+            Failure::new(Exit::NoRig, format!("{}: {what}", sig.name())).into()
+        }
+        Some(Halt::StoppedElsewhere) => Failure::new(
+            if confirmed {
+                Exit::Refused
+            } else {
+                Exit::NoRig
+            },
+            format!(
+                "the drive was stopped from elsewhere (`kapitza stop`, the monitor's s, or the \
+                 rig itself): {what}"
+            ),
+        )
+        .into(),
+        None if confirmed => e,
+        None => e.context(format!("{stop}; {before}")),
+    }
 }

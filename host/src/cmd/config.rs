@@ -321,7 +321,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         }
         Action::Set { rig, file } => {
             crate::files::check_input("the configuration file", file)?;
-            let mut s = rig.connect()?;
+            let mut s = rig.connect_to_change("kapitza config set")?;
             let new =
                 read(file, &s.config).map_err(|e| Failure::new(Exit::Refused, format!("{e:#}")))?;
             s.call(|c| c.set_config(&new))?;

@@ -56,14 +56,17 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         speed: args.speed,
     };
     let target: Target = rig.target()?;
+    crate::signals::catch();
     let mut feed = open_feed(&target, &rig.sim_options()?)?;
     let mut script = Script::new();
     let opts = Options::default();
     if args.json {
         monitor::run_plain(feed.as_mut(), Some(&mut script), &opts, Plain::Nothing, out)?;
+        monitor::close(feed.as_mut())?;
+        let signal = crate::signals::caught().map(|s| s.name());
         let report = Report {
             steps: &script.outcomes,
-            aborted: script.aborted.as_deref(),
+            aborted: script.aborted.as_deref().or(signal),
         };
         serde_json::to_writer_pretty(&mut *out, &report)?;
         writeln!(out)?;
@@ -73,7 +76,11 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         } else {
             monitor::run_tui(feed.as_mut(), Some(&mut script), &opts, true)?;
         }
+        monitor::close(feed.as_mut())?;
         print_table(&script.outcomes, out)?;
+    }
+    if let Some(sig) = crate::signals::caught() {
+        return Err(sig.failure("the demo was stopped before its end; the drive is stopped"));
     }
     if let Some(why) = &script.aborted {
         bail!("the demo stopped early: {why}");

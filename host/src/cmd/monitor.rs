@@ -20,7 +20,8 @@ use crate::rig::simhost::SimOptions;
 /// Off a terminal (or with --plain) it prints one JSON object per telemetry frame instead.
 ///
 /// While it runs it owns the port: it keeps the link alive, and `kapitza set`, `status`, `stop`
-/// in other terminals go through it. Quitting stops the drive.
+/// in other terminals go through it. Quitting (q, Ctrl-C, SIGTERM, SIGHUP) stops the drive: exit
+/// 0 once the rig confirmed the stop, 3 if it did not.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -58,6 +59,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     if let Some(p) = &args.csv {
         crate::files::check_output("--csv", p, csv_existing)?;
     }
+    crate::signals::catch();
     let mut feed = open_feed(&args.rig.target()?, &args.rig.sim_options()?)?;
     let opts = Options {
         duration: args.duration,
@@ -69,5 +71,5 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     } else {
         monitor::run_tui(feed.as_mut(), None, &opts, false)?;
     }
-    Ok(())
+    monitor::close(feed.as_mut())
 }

@@ -8,6 +8,7 @@ use crate::rig::file::{self, RigFile};
 use crate::rig::port::{self, Target};
 use crate::rig::session::{self, Session};
 use crate::rig::simhost::SimOptions;
+use crate::rig::{served, Exit, Failure};
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct RigArgs {
@@ -68,5 +69,22 @@ impl RigArgs {
     /// A checked connection to the rig.
     pub fn connect(&self) -> Result<Session> {
         session::connect(&self.target()?, &self.sim_options()?)
+    }
+
+    /// A checked connection for `command`, which changes the rig: refused, before anything is
+    /// sent, while a command that must not be disturbed (a calibration) owns the port.
+    pub fn connect_to_change(&self, command: &str) -> Result<Session> {
+        let target = self.target()?;
+        let s = session::connect(&target, &self.sim_options()?)?;
+        if let (Target::Serial { path }, true) = (&target, s.via_owner) {
+            if let Some(why) = served::busy(path) {
+                return Err(Failure::new(
+                    Exit::Refused,
+                    format!("{path}: {why}: `{command}` was not sent; nothing changed"),
+                )
+                .into());
+            }
+        }
+        Ok(s)
     }
 }

@@ -21,7 +21,8 @@ use crate::rig::{self as rigmod};
 #[derive(Debug, clap::Subcommand)]
 pub enum Action {
     /// Serve a simulated rig on a pseudo-terminal (Unix): prints the device path, then runs
-    /// until Ctrl-C or --duration.
+    /// until Ctrl-C (or SIGTERM, SIGHUP) or --duration; then removes --link and prints its
+    /// summary.
     Serve(ServeArgs),
 }
 
@@ -57,7 +58,7 @@ pub struct ServeArgs {
     /// Add to the end of an existing --truth file.
     #[arg(long, requires = "truth")]
     pub append: bool,
-    /// Stop after this many wall seconds (default: run until Ctrl-C).
+    /// Stop after this many wall seconds (default: run until a signal).
     #[arg(allow_hyphen_values = true, long, value_name = "S")]
     pub duration: Option<f64>,
     /// Speak this link protocol version instead of this tool's (for tests of version skew).
@@ -137,6 +138,8 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         )?)),
         None => None,
     };
+    // Before the link is published: a signal from then on still removes it.
+    rigmod::catch_interrupt();
     let (mut master, slave) = TTYPort::pair().context("cannot open a pseudo-terminal")?;
     set_nonblocking(&master)?;
     master.set_timeout(std::time::Duration::ZERO)?;
@@ -146,7 +149,6 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     }
     writeln!(out, "{path}")?;
     out.flush()?;
-    rigmod::catch_interrupt();
     let start = Instant::now();
     let stop =
         || rigmod::interrupted() || duration.is_some_and(|d| start.elapsed().as_secs_f64() >= d);

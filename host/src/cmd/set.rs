@@ -6,20 +6,28 @@
 //! the rig has taken the command, or with `--wait` once the pendulum has settled. On its own it
 //! owns the port and stays attached, printing the status as it changes, until the pendulum has
 //! settled (`--wait`; then the drive follows the rig's link-loss policy: a soft stop a second
-//! later) or until Ctrl-C, which stops the drive.
+//! later) or until Ctrl-C (or SIGTERM, SIGHUP), which stops the drive.
+//!
+//! Exit statuses beyond 0/1/3: 4 `--wait` timed out; 5 another command replaced the target
+//! before it settled ("superseded by …", naming its R and θd); a signal during `--wait` stops the
+//! drive and exits 130 / 143 / 129 (3 when the rig did not confirm the stop). A signal ends a
+//! plain `set`, which holds the drive until then, with 0 once the stop is confirmed.
 
 use std::io::Write;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
+use kapitza_core::link::convert::from_q16;
 use kapitza_core::link::message::{Check, Mode};
 use kapitza_core::link::Telemetry;
+use kapitza_core::rig::config::RigConfig;
 
 use super::progress::progress_writer;
 use super::rig_args::RigArgs;
 use crate::link::{Error, LineError};
 use crate::rig::session::{line_failure, Session, StatusView};
 use crate::rig::{self, Exit, Failure};
+use crate::signals;
 
 /// Set the drive strength R and the drive angle θd: starts the drive from idle, or changes it
 /// (ramped and slewed at the rig's rate limits). R = 0 stops.
@@ -79,7 +87,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     }
     let timeout = crate::input::positive("--timeout", args.timeout)?;
     rig::catch_interrupt();
-    let mut s = args.rig.connect()?;
+    let mut s = args.rig.connect_to_change("kapitza set")?;
     if let Some(on) = &args.closed_loop {
         let mut cfg = s.config;
         cfg.closed_loop.enabled = on == "on";
@@ -89,6 +97,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         }
     }
     let starts = args.r > 0.0 && s.call(|c| c.status())?.mode == Mode::Idle;
+    signals::check(|| "nothing was sent".into())?;
     s.call(|c| c.set_drive(args.r, args.angle))?;
     if starts {
         if let Err(why) = await_check(&mut s)? {
@@ -105,7 +114,12 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
             .into());
         }
     }
-    let after = s.call(|c| c.status())?.counters.commands;
+    let st = s.call(|c| c.status())?;
+    let after = st.counters.commands;
+    let ours = Target {
+        r: args.r,
+        theta_d_deg: args.angle,
+    };
     let mut progress = progress_writer(args.json, &mut *out);
     writeln!(
         progress,
@@ -118,10 +132,11 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         let deadline = args
             .wait
             .then(|| Instant::now() + Duration::from_secs_f64(timeout));
-        follow(&mut s, after, deadline, &mut progress)?
+        follow(&mut s, after, ours, deadline, &mut progress)?
     };
     drop(progress);
     if !done {
+        writeln!(out, "{}: the rig confirmed the stop", s.name)?;
         return Ok(());
     }
     let view = s.snapshot()?;
@@ -138,6 +153,9 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
 fn await_check(s: &mut Session) -> Result<Result<(), String>> {
     let deadline = Instant::now() + CHECK_TIMEOUT;
     loop {
+        if let Some(sig) = signals::caught() {
+            return Err(stopped(s, sig, true));
+        }
         let st = s.call(|c| c.status())?;
         match st.check {
             Some(Check::Running) => {}
@@ -156,12 +174,80 @@ fn await_check(s: &mut Session) -> Result<Result<(), String>> {
     }
 }
 
+/// The drive's target this command asked for; another command's `set` changes the status's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Target {
+    r: f64,
+    theta_d_deg: f64,
+}
+
+/// How far the status's target may lie from the one asked for and still be it: the link's
+/// I16F16 ω and θd round to 1.5e-5 (relative 1e-6 in R at ω ≈ 30 rad/s and above).
+const SAME_R: f64 = 1e-4;
+const SAME_DEG: f64 = 1e-3;
+
+impl Target {
+    /// Whether the status `st` carries another command's target rather than this one. With
+    /// closed-loop R on, the rig trims ω itself within the configuration's band (in R).
+    fn replaced_by(&self, st: &kapitza_core::link::Status, cfg: &RigConfig) -> bool {
+        let r = cfg.r_for_omega(from_q16(st.omega_target));
+        let deg = from_q16(st.theta_d_target_deg);
+        let band = if cfg.closed_loop.enabled {
+            cfg.closed_loop.band.max(SAME_R)
+        } else {
+            SAME_R
+        };
+        (deg - self.theta_d_deg).abs() > SAME_DEG || (r - self.r).abs() > band
+    }
+}
+
+/// A signal while following: the drive stopped first. With `--wait` the signal's exit status
+/// (the wait did not finish), else 0 once the rig confirmed the stop (a plain `set` ends so);
+/// 3 when it did not confirm.
+fn stopped(s: &mut Session, sig: signals::Signal, wait: bool) -> anyhow::Error {
+    if s.client.stop().is_err() {
+        return Failure::new(
+            Exit::NoRig,
+            format!(
+                "{}: {}: the rig did not confirm the stop: it stops by itself once the line has \
+                 been silent for its link timeout (link_timeout_ms, 1 s unless configured)",
+                s.name,
+                sig.name()
+            ),
+        )
+        .into();
+    }
+    let what = format!(
+        "{}: interrupted before the pendulum settled; the drive is stopping (the rig confirmed \
+         the stop)",
+        s.name
+    );
+    if wait {
+        sig.failure(what)
+    } else {
+        Interrupted.into()
+    }
+}
+
+/// A plain `set` ended by a signal, the stop confirmed: not a failure.
+#[derive(Debug)]
+struct Interrupted;
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("interrupted")
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
 /// Follows the rig until the pendulum has settled after command number `after` (returns true),
-/// Ctrl-C (the drive is stopped; returns false) or the deadline (exit 4). Without a deadline
-/// only Ctrl-C ends it.
+/// a signal (the drive is stopped; returns false without `--wait`), the deadline (exit 4) or
+/// another command's target (exit 5). Without a deadline only a signal ends it.
 fn follow(
     s: &mut Session,
     after: u32,
+    ours: Target,
     deadline: Option<Instant>,
     progress: &mut dyn Write,
 ) -> Result<bool> {
@@ -170,10 +256,13 @@ fn follow(
     let mut last_stage = "";
     let mut next_line = Instant::now();
     loop {
-        if rig::interrupted() {
-            s.call(|c| c.stop())?;
-            writeln!(progress, "interrupted: the drive is stopping")?;
-            return Ok(false);
+        if let Some(sig) = signals::caught() {
+            let e = stopped(s, sig, deadline.is_some());
+            if e.is::<Interrupted>() {
+                writeln!(progress, "{}: the drive is stopping", sig.name())?;
+                return Ok(false);
+            }
+            return Err(e);
         }
         if deadline.is_some_and(|d| Instant::now() >= d) {
             return Err(Failure::new(
@@ -185,6 +274,7 @@ fn follow(
         if Instant::now() >= next_alive {
             next_alive = Instant::now() + KEEP_ALIVE;
             let st = s.call(|c| c.status())?;
+            superseded(s, &st, ours)?;
             if let Mode::Faulted(_) | Mode::Idle = st.mode {
                 let v = StatusView::new(&st, None, &s.config);
                 let why = v.fault.or(v.last_stop).unwrap_or("stopped");
@@ -210,9 +300,30 @@ fn follow(
             next_line = Instant::now() + PROGRESS_EVERY;
         }
         if t.settled && deadline.is_some() {
+            // Settled, but at whose target: the status says.
+            let st = s.call(|c| c.status())?;
+            superseded(s, &st, ours)?;
             return Ok(true);
         }
     }
+}
+
+/// Exit 5 when the status's target is another command's: a new drive, not a stop (a stop
+/// from elsewhere ends the wait as a stopped drive).
+fn superseded(s: &Session, st: &kapitza_core::link::Status, ours: Target) -> Result<()> {
+    if st.omega_target != 0 && ours.replaced_by(st, &s.config) {
+        let v = StatusView::new(st, None, &s.config);
+        return Err(Failure::new(
+            Exit::Superseded,
+            format!(
+                "{}: superseded by another command's R = {:.3} at θd = {:.1}° before the \
+                 pendulum settled",
+                s.name, v.r_target, v.drive_angle_target_deg
+            ),
+        )
+        .into());
+    }
+    Ok(())
 }
 
 /// What the drive and the estimator are doing.
@@ -229,7 +340,6 @@ fn stage(t: &Telemetry) -> &'static str {
 /// One line of what the rig does.
 fn progress_line(t: &Telemetry) -> String {
     use crate::rig::names::turns_deg;
-    use kapitza_core::link::convert::from_q16;
     let phi = match (t.settled, t.equilibrium) {
         (true, Some(e)) => turns_deg(e),
         _ => turns_deg(t.phi),

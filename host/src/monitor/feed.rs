@@ -58,4 +58,9 @@ pub trait Feed {
     fn next_event(&mut self, timeout: Duration) -> Option<Event>;
     /// Carries out `c`; `Err` names why not (the line, or the rig's refusal and its reason).
     fn command(&mut self, c: Command) -> Result<(), String>;
+    /// Stops the drive and lets go of the rig: whether the rig confirmed the stop (`None`: a
+    /// feed that drives nothing).
+    fn close(&mut self) -> Option<bool> {
+        None
+    }
 }

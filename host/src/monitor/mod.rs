@@ -140,7 +140,10 @@ impl<'a, 'b> Session<'a, 'b> {
         let timed_out = self
             .duration
             .is_some_and(|d| self.state.t_s() >= d || self.last_event.elapsed().as_secs_f64() >= d);
-        self.state.quit || timed_out || self.driver.as_ref().is_some_and(|d| d.finished())
+        self.state.quit
+            || timed_out
+            || self.driver.as_ref().is_some_and(|d| d.finished())
+            || crate::signals::caught().is_some()
     }
 
     fn finish(mut self) -> Result<State> {
@@ -150,6 +153,24 @@ impl<'a, 'b> Session<'a, 'b> {
         }
         Ok(self.state)
     }
+}
+
+/// Closes `feed` (the drive stopped) and says on stderr whether the rig confirmed the stop:
+/// `Ok` if it did (or the feed drives nothing), exit 3 if it did not.
+pub fn close(feed: &mut dyn Feed) -> Result<()> {
+    match feed.close() {
+        Some(true) => eprintln!("the drive is stopped: the rig confirmed the stop"),
+        Some(false) => {
+            return Err(crate::rig::Failure::new(
+                crate::rig::Exit::NoRig,
+                "the rig did not confirm the stop: it stops by itself once the line has been \
+                 silent for its link timeout (link_timeout_ms, 1 s unless configured)",
+            )
+            .into())
+        }
+        None => {}
+    }
+    Ok(())
 }
 
 /// Runs off a terminal until the duration, the driver's end, or the feed's silence for the
@@ -220,7 +241,7 @@ fn tui_loop(s: &mut Session, terminal: &mut ratatui::DefaultTerminal, stay: bool
             }
         }
         let finished = s.driver.as_ref().is_some_and(|d| d.finished());
-        if s.state.quit || (s.done() && !(stay && finished)) {
+        if s.state.quit || crate::signals::caught().is_some() || (s.done() && !(stay && finished)) {
             return Ok(());
         }
     }

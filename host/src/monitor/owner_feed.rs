@@ -28,7 +28,8 @@ pub struct OwnerFeed {
     early: VecDeque<Event>,
     commands: Sender<(Command, Reply)>,
     stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
+    /// Ends with whether the rig confirmed the stop.
+    thread: Option<JoinHandle<bool>>,
 }
 
 fn linked(o: &mut Owner) -> Option<Event> {
@@ -88,13 +89,12 @@ impl OwnerFeed {
                     };
                     if ev_tx.send(ev).is_err() {
                         // Nobody is watching any more: the rig's own timeout backs the stop.
-                        let _ = owner.shutdown();
-                        return;
+                        return owner.shutdown();
                     }
                 }
                 std::thread::sleep(Duration::from_millis(2));
             }
-            let _ = owner.shutdown();
+            owner.shutdown()
         });
         Self {
             events,
@@ -134,15 +134,18 @@ impl Feed for OwnerFeed {
             }
         }
     }
+
+    fn close(&mut self) -> Option<bool> {
+        self.stop.store(true, Ordering::Relaxed);
+        // Let go of the events first: a thread waiting to hand one over then sees the end.
+        drop(std::mem::replace(&mut self.events, mpsc::sync_channel(0).1));
+        let t = self.thread.take()?;
+        Some(t.join().unwrap_or(false))
+    }
 }
 
 impl Drop for OwnerFeed {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        // Let go of the events first: a thread waiting to hand one over then sees the end.
-        drop(std::mem::replace(&mut self.events, mpsc::sync_channel(0).1));
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
+        let _ = self.close();
     }
 }

@@ -11,9 +11,12 @@
 //! | [`session`] | a checked connection (version, configuration) and the rig's state in user units |
 //! | [`names`] | modes, faults and stop reasons as every output names them; wire angles in degrees |
 //! | [`owner`] | the process that owns a port serves a control socket; one-shot commands use it |
+//! | [`served`] | the control socket of a command that drives the link itself (`calibrate`) |
 //!
-//! Exit statuses of the rig commands: 0 done, 1 refused, 2 usage, 3 no rig / the line failed,
-//! 4 `--wait` timed out ([`Exit`]).
+//! Exit statuses of the rig commands ([`Exit`]): 0 done, 1 refused or failed (the message says
+//! what, if anything, changed), 2 usage, 3 no rig / the line failed (a stop the rig did not
+//! confirm included), 4 `--wait` timed out, 5 superseded, 129 / 130 / 143 ended by SIGHUP /
+//! SIGINT / SIGTERM after the stop.
 
 pub mod fields;
 pub mod file;
@@ -21,12 +24,11 @@ pub mod names;
 pub mod owner;
 pub mod port;
 pub mod predicted;
+pub mod served;
 pub mod session;
 pub mod simhost;
 
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Once;
 
 /// Why a rig command failed, as its exit status.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,6 +39,14 @@ pub enum Exit {
     NoRig = 3,
     /// `--wait` ran out of time.
     WaitTimeout = 4,
+    /// `--wait`: another command replaced the target before it settled.
+    Superseded = 5,
+    /// Ended by SIGHUP (128 + 1), after the stop.
+    HungUp = 129,
+    /// Ended by SIGINT (Ctrl-C, 128 + 2), after the stop.
+    Interrupted = 130,
+    /// Ended by SIGTERM (128 + 15), after the stop.
+    Terminated = 143,
 }
 
 /// A failure with the exit status it calls for.
@@ -63,18 +73,13 @@ impl fmt::Display for Failure {
 
 impl std::error::Error for Failure {}
 
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-static HANDLER: Once = Once::new();
-
-/// Catches Ctrl-C from here on: [`interrupted`] turns true instead of the process dying, so a
-/// command can stop the drive before it exits.
+/// Catches SIGINT, SIGTERM and SIGHUP from here on ([`crate::signals::catch`]): a command can
+/// stop the drive before it exits.
 pub fn catch_interrupt() {
-    HANDLER.call_once(|| {
-        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
-    });
+    crate::signals::catch();
 }
 
-/// Ctrl-C was pressed since [`catch_interrupt`].
+/// A signal arrived since [`catch_interrupt`].
 pub fn interrupted() -> bool {
-    INTERRUPTED.load(Ordering::SeqCst)
+    crate::signals::caught().is_some()
 }

@@ -74,10 +74,10 @@ pub fn connect(port: &str) -> Option<UnixStream> {
 static NEXT_CLIENT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// A request from a socket client, to be relayed.
-struct Job {
-    client: usize,
-    seq: u8,
-    req: Request,
+pub(super) struct Job {
+    pub(super) client: usize,
+    pub(super) seq: u8,
+    pub(super) req: Request,
 }
 
 /// What the owner saw in one turn.
@@ -297,7 +297,7 @@ impl Owner {
 
 /// Whether a socket client is still there after a write: a client that does not read loses
 /// frames (the write times out), never the owner its turn; a closed one is forgotten.
-fn still_there(r: std::io::Result<()>) -> bool {
+pub(super) fn still_there(r: std::io::Result<()>) -> bool {
     match r {
         Ok(()) => true,
         Err(e) => matches!(
@@ -317,7 +317,11 @@ impl Drop for Owner {
 
 /// Binds the control socket of `port` and accepts clients on a thread of its own; each
 /// client's frames are read on a thread and queued as jobs.
-fn listen(port: &str, jobs: Sender<Job>, clients: Sender<(usize, UnixStream)>) -> Result<PathBuf> {
+pub(super) fn listen(
+    port: &str,
+    jobs: Sender<Job>,
+    clients: Sender<(usize, UnixStream)>,
+) -> Result<PathBuf> {
     let path = socket_path(port);
     let dir = path.parent().context("control socket path")?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -328,6 +332,8 @@ fn listen(port: &str, jobs: Sender<Job>, clients: Sender<(usize, UnixStream)>) -
         );
     }
     let _ = std::fs::remove_file(&path);
+    // A marker left by a command that died without its cleanup (`super::served`).
+    let _ = std::fs::remove_file(path.with_extension("busy"));
     let listener = UnixListener::bind(&path)
         .with_context(|| format!("cannot open the control socket {}", path.display()))?;
     std::thread::spawn(move || {

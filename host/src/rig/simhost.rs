@@ -87,6 +87,9 @@ pub struct Applied {
     pub omega_target: f64,
     pub r_target: f64,
     pub drive_angle_target_deg: f64,
+    /// In bring-up mode: its open-loop duty (the crank's motor, 0 when only the servo holds);
+    /// else null.
+    pub bring_up_duty: Option<f64>,
 }
 
 impl Applied {
@@ -103,6 +106,10 @@ impl Applied {
                 sup.theta_d_target(),
                 srv.cfg.limits.drive_angle_min_deg,
             ),
+            bring_up_duty: match srv.activity {
+                Activity::BringUp { duty } => Some(f64::from(duty.to_bits()) / 32_768.0),
+                _ => None,
+            },
         }
     }
 }
