@@ -6,6 +6,7 @@
 //! | [`port`] | `--port`: a device, `auto` (the one ST-LINK), `sim`; listing ports; opening one |
 //! | [`file`] | rig files: a simulated rig's true physics and the configuration it is given |
 //! | [`simhost`] | a simulated rig against the wall clock (real time × speed), on any line |
+//! | [`live`] | which of the estimator's numbers describe the pendulum now (never a frozen one) |
 //! | [`predicted`] | what the model expects of the configured pendulum at a drive (the `predict` code) |
 //! | [`session`] | a checked connection (version, configuration) and the rig's state in user units |
 //! | [`names`] | modes, faults and stop reasons as every output names them; wire angles in degrees |
@@ -15,6 +16,7 @@
 //! 4 `--wait` timed out ([`Exit`]).
 
 pub mod file;
+pub mod live;
 pub mod names;
 pub mod owner;
 pub mod port;
