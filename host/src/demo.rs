@@ -109,6 +109,37 @@ enum Phase {
     Done,
 }
 
+/// The table of measured against predicted, one line per step under a header: 71 columns, so
+/// it fits the dashboard on an 80-column terminal as well as the terminal after it.
+pub fn table(rows: &[Outcome]) -> Vec<String> {
+    let show = |x: Option<f64>, prec: usize| x.map_or("—".into(), |v| format!("{v:.prec$}"));
+    let angle = |x: Option<f64>| x.map_or("—".into(), show_deg);
+    let mut lines = vec![format!(
+        "{:>5} {:>6} {:>8} {:>9} {:>9} {:>7} {:>7} {:>6} {:>6}",
+        "R", "θd (°)", "settle s", "φ0 meas", "φ0 pred", "ωp meas", "ωp pred", "R meas", "R req"
+    )];
+    for o in rows {
+        lines.push(format!(
+            "{:>5.2} {:>6.1} {:>8} {:>9} {:>9} {:>7} {:>7} {:>6} {:>6.3}{}",
+            o.r,
+            o.drive_angle_deg,
+            show(o.settle_s, 1),
+            angle(o.measured.phi0_deg),
+            angle(o.predicted.phi0_deg),
+            show(o.measured.omega_p, 3),
+            show(o.predicted.omega_p, 3),
+            show(o.measured.r, 3),
+            o.predicted.r,
+            if o.predicted.outside_reach {
+                "  outside reach"
+            } else {
+                ""
+            },
+        ));
+    }
+    lines
+}
+
 /// The demo's script: see the [module doc](self).
 #[derive(Debug, Clone)]
 pub struct Script {
@@ -139,6 +170,12 @@ impl Script {
     fn abort(&mut self, state: &mut State, why: String) {
         state.note(format!("demo stopped: {why}"));
         self.aborted = Some(why);
+        self.done(state);
+    }
+
+    /// The end: the table stays on the dashboard.
+    fn done(&mut self, state: &mut State) {
+        state.summary = table(&self.outcomes);
         self.phase = Phase::Done;
     }
 
@@ -283,7 +320,7 @@ impl Driver for Script {
                     } else {
                         "demo: done, but the drive has not run down"
                     });
-                    self.phase = Phase::Done;
+                    self.done(state);
                 }
                 None
             }

@@ -5,7 +5,7 @@
 //! title: link, mode, fault
 //! drive: R, ω, θd — set point against actual   │  pendulum: φ against the predicted φ0,
 //!                                              │  ωp and R measured against predicted, settled
-//! chart: the slow angle φ and the predicted φ0 over the last minute
+//! chart: the slow angle φ and the predicted φ0 over the last minute (at a demo's end, its table)
 //! event log
 //! keys: s stop (always shown), c clear fault, q quit
 //! ```
@@ -46,7 +46,13 @@ pub fn draw(frame: &mut Frame, state: &State) {
         Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(panels);
     frame.render_widget(drive_panel(readings.as_ref()), drive);
     frame.render_widget(pendulum_panel(readings.as_ref()), pendulum);
-    draw_chart(frame, chart, state);
+    if state.summary.is_empty() {
+        draw_chart(frame, chart, state);
+    } else {
+        let lines: Vec<Line> = state.summary.iter().map(|l| Line::from(format!(" {l}"))).collect();
+        let title = " measured against predicted (q to leave) ";
+        frame.render_widget(Paragraph::new(lines).block(Block::bordered().title(title)), chart);
+    }
     frame.render_widget(log_panel(state, log.height.saturating_sub(2), log.width), log);
     frame.render_widget(key_line(), keys);
 }

@@ -129,6 +129,9 @@ pub struct State {
     /// Lines ever logged (the log drops old ones; writers of new lines count on this).
     pub logged: u64,
     pub quit: bool,
+    /// A result table a driver leaves on the dashboard in place of the chart (the demo's, at
+    /// its end); empty: the chart.
+    pub summary: Vec<String>,
     /// Rig µs since the first frame (summed exactly), and the rig's µs clock at the last frame
     /// (`None`: take the next frame as the base, as after a reconnect to a rig whose clock
     /// restarted).
@@ -155,6 +158,7 @@ impl State {
             log: VecDeque::new(),
             logged: 0,
             quit: false,
+            summary: Vec::new(),
             elapsed_us: 0,
             last_us: None,
             commands_seen: 0,
