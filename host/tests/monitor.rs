@@ -440,11 +440,17 @@ fn dashboard_fits_80_by_24() {
         "clear fault",
         "quit",
     ] {
-        assert!(text.contains(want), "{want} cut from the 80×24 screen:\n{text}");
+        assert!(
+            text.contains(want),
+            "{want} cut from the 80×24 screen:\n{text}"
+        );
     }
     // The keys on the last row, the title on the first.
     assert!(text.lines().last().unwrap().contains("STOP"), "{text}");
-    assert!(text.lines().next().unwrap().contains("mode: running"), "{text}");
+    assert!(
+        text.lines().next().unwrap().contains("mode: running"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -463,12 +469,18 @@ fn idle_shows_the_live_angle_not_a_stale_one_nor_drive_changing() {
     s.on_event(Event::Telemetry(idle));
     let r = s.readings().unwrap();
     assert_eq!(r.slow_angle_deg, None);
-    assert_eq!((r.omega_p, r.r_estimate, r.equilibrium_deg), (None, None, None));
+    assert_eq!(
+        (r.omega_p, r.r_estimate, r.equilibrium_deg),
+        (None, None, None)
+    );
     assert!(!r.settled);
     let text = screen(&s, 80, 24);
     assert!(!text.contains("drive changing"), "{text}");
     assert!(text.contains("drive idle"), "{text}");
-    assert!(!text.contains("179.998") && !text.contains("180.00"), "{text}");
+    assert!(
+        !text.contains("179.998") && !text.contains("180.00"),
+        "{text}"
+    );
     // --plain's record: null, not the stale value.
     let v = serde_json::to_value(&r).unwrap();
     assert!(v["slow_angle_deg"].is_null(), "{v}");

@@ -83,17 +83,18 @@ fn with_its_body_the_rod_settles_within_reach_and_idle_forgets_the_slow_angle() 
     assert!(apart(phi, 80.0) <= 90.0, "φ0 {phi}: past the body");
     assert_eq!(p["outside_reach"], false, "{v}");
     // The model's one reachable stable equilibrium (49.69° by physics §3's condition
-    // sin φ0 + (R/2) sin 2(φ0 − θd) = 0) is the prediction, to the root finder's rounding,
-    // and the other stable one (−59.7°, 140° from the blade) is listed.
+    // sin φ0 + (R/2) sin 2(φ0 − θd) = 0) is the prediction, and the other stable one (−59.7°,
+    // 140° from the blade) is listed; 1e-3°: the rig's R is that of its ω target on the wire
+    // (I16F16), within 1e-5 of 1.75.
     let model = model_80();
     assert_eq!(model.len(), 2, "{model:?}");
     let reach = model.iter().find(|e| e.1).unwrap().0;
     let other = model.iter().find(|e| !e.1).unwrap().0;
     let pred = p["phi0_deg"].as_f64().unwrap();
-    assert!((pred - reach).abs() < 1e-6, "{pred} vs {reach}");
+    assert!((pred - reach).abs() < 1e-3, "{pred} vs {reach}");
     let others = p["other_stable"].as_array().unwrap();
     assert_eq!(others.len(), 1, "{p}");
-    assert!((others[0]["phi0_deg"].as_f64().unwrap() - other).abs() < 1e-6);
+    assert!((others[0]["phi0_deg"].as_f64().unwrap() - other).abs() < 1e-3);
     assert!(others[0]["omega_p"].as_f64().unwrap() > 0.0);
     // Measured within 1° of it: the averaged theory against the full motion the rig runs,
     // O((A/ℓ)², (ω0/ω)²) ≈ 0.4 % of the angles here, plus the estimator's settle band (0.3°).
@@ -132,8 +133,8 @@ fn without_a_body_an_out_of_reach_rest_is_flagged() {
     let outside = apart(phi, 80.0) > 91.0;
     eprintln!("no body: settled at {phi:.3}° (outside reach: {outside}), predicted {p}");
     assert_eq!(p["outside_reach"], outside, "{v}");
-    // Wherever it rests, the prediction is the model's stable equilibrium nearest to it and
-    // within 1° of it (as above).
+    // Wherever it rests, the prediction is the model's stable equilibrium nearest to it (1e-3°,
+    // as above) and within 1° of it (as above).
     let model = model_80();
     let nearest = model
         .iter()
@@ -141,13 +142,12 @@ fn without_a_body_an_out_of_reach_rest_is_flagged() {
         .unwrap()
         .0;
     let pred = p["phi0_deg"].as_f64().unwrap();
-    assert!((pred - nearest).abs() < 1e-6, "{pred} vs {nearest}");
+    assert!((pred - nearest).abs() < 1e-3, "{pred} vs {nearest}");
     assert!(apart(phi, nearest) < 1.0, "φ0 {phi} vs model {nearest}");
     if outside {
-        let text = String::from_utf8(
-            kapitza(&["status", "--port", rig.first_line.as_str()]).stdout,
-        )
-        .unwrap();
+        let text =
+            String::from_utf8(kapitza(&["status", "--port", rig.first_line.as_str()]).stdout)
+                .unwrap();
         assert!(text.contains("outside reach"), "{text}");
     }
 }

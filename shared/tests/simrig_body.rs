@@ -64,7 +64,11 @@ fn jog_then_drive(body: Option<Body>) -> (Stretch, Stretch) {
     });
     assert_eq!(r, Response::Ok);
     let jog = run(&mut b, 8.0);
-    assert!((theta_d_deg(&b.sim) - 190.0).abs() < 0.01, "{}", theta_d_deg(&b.sim));
+    assert!(
+        (theta_d_deg(&b.sim) - 190.0).abs() < 0.01,
+        "{}",
+        theta_d_deg(&b.sim)
+    );
     assert_eq!(b.ask(Request::Stop), Response::Ok);
     run(&mut b, 0.2);
     let r = b.ask(Request::SetDrive {
@@ -96,15 +100,31 @@ fn a_rod_slewed_past_the_body_is_pushed_and_rests_within_reach() {
     // 180°), and the drive then leaves it on the far side, at −arccos(1/R), 153° from the
     // blade: what the body stops.
     assert!(free_jog.max_from_blade_deg > 170.0);
-    assert!(math::wrap_deg(free.rest_deg - 90.0).abs() > 90.0, "{}", free.rest_deg);
+    assert!(
+        math::wrap_deg(free.rest_deg - 90.0).abs() > 90.0,
+        "{}",
+        free.rest_deg
+    );
     // With it: pushed up to θd − 90° = 100° and held there against gravity (within the
     // sensor-free truth's rounding and the impacts' settling: 0.1°).
-    assert!(jog.max_from_blade_deg <= 90.0 + 1e-6, "{}", jog.max_from_blade_deg);
+    assert!(
+        jog.max_from_blade_deg <= 90.0 + 1e-6,
+        "{}",
+        jog.max_from_blade_deg
+    );
     assert!((jog.rest_deg - 100.0).abs() < 0.1, "{}", jog.rest_deg);
     // Driven, never past the body, at rest at the model's stable equilibrium nearest to it,
     // the reachable one.
-    assert!(driven.max_from_blade_deg <= 90.0 + 1e-6, "{}", driven.max_from_blade_deg);
-    assert!(driven.range_deg < 10.0, "still swinging: {}", driven.range_deg);
+    assert!(
+        driven.max_from_blade_deg <= 90.0 + 1e-6,
+        "{}",
+        driven.max_from_blade_deg
+    );
+    assert!(
+        driven.range_deg < 10.0,
+        "still swinging: {}",
+        driven.range_deg
+    );
     let eq = equilibria(2.2, DriveAngle::from_deg(90.0).unwrap()).unwrap();
     let nearest = eq
         .stable()
@@ -122,5 +142,9 @@ fn a_rod_slewed_past_the_body_is_pushed_and_rests_within_reach() {
     // 1°: the averaged theory's φ0 against the full equation's period mean at the rig's ω,
     // O((A/ℓ)², (ω0/ω)²) ≈ 0.4 % of the angle here (the e2e tests in docs/rig.md hold the rig
     // to 0.5° of the full equation itself), and the 4° wobble's residue in a one-second mean.
-    assert!((driven.rest_deg - phi0).abs() < 1.0, "{} vs {phi0}", driven.rest_deg);
+    assert!(
+        (driven.rest_deg - phi0).abs() < 1.0,
+        "{} vs {phi0}",
+        driven.rest_deg
+    );
 }

@@ -49,11 +49,21 @@ pub fn draw(frame: &mut Frame, state: &State) {
     if state.summary.is_empty() {
         draw_chart(frame, chart, state);
     } else {
-        let lines: Vec<Line> = state.summary.iter().map(|l| Line::from(format!(" {l}"))).collect();
+        let lines: Vec<Line> = state
+            .summary
+            .iter()
+            .map(|l| Line::from(format!(" {l}")))
+            .collect();
         let title = " measured against predicted (q to leave) ";
-        frame.render_widget(Paragraph::new(lines).block(Block::bordered().title(title)), chart);
+        frame.render_widget(
+            Paragraph::new(lines).block(Block::bordered().title(title)),
+            chart,
+        );
     }
-    frame.render_widget(log_panel(state, log.height.saturating_sub(2), log.width), log);
+    frame.render_widget(
+        log_panel(state, log.height.saturating_sub(2), log.width),
+        log,
+    );
     frame.render_widget(key_line(), keys);
 }
 
@@ -256,7 +266,9 @@ fn angle_bounds(points: impl Iterator<Item = f64>) -> (f64, f64) {
 /// line loses nothing).
 fn log_panel(state: &State, rows: u16, width: u16) -> Paragraph<'static> {
     const STAMP: usize = 12;
-    let text_w = usize::from(width.saturating_sub(2)).saturating_sub(STAMP).max(10);
+    let text_w = usize::from(width.saturating_sub(2))
+        .saturating_sub(STAMP)
+        .max(10);
     let mut lines: Vec<Line> = Vec::new();
     for (t, text) in &state.log {
         let chars: Vec<char> = text.chars().collect();

@@ -192,6 +192,9 @@ mod tests {
         };
         assert_eq!(relayed(&set).as_deref(), Some("set R = 1.750, θd = 80.0°"));
         assert_eq!(relayed(&Request::Stop).as_deref(), Some("stop"));
-        assert_eq!(relayed(&Request::ClearFault).as_deref(), Some("clear fault"));
+        assert_eq!(
+            relayed(&Request::ClearFault).as_deref(),
+            Some("clear fault")
+        );
     }
 }

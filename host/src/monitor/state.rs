@@ -315,9 +315,9 @@ impl State {
                 .map(crate::rig::names::turns_deg),
             predicted_phi0_deg: prediction.as_ref().map(|p| p.phi0_deg),
             outside_reach: prediction.as_ref().is_some_and(|p| p.outside_reach),
-            other_stable_deg: prediction
-                .as_ref()
-                .map_or(Vec::new(), |p| p.other_stable.iter().map(|o| o.phi0_deg).collect()),
+            other_stable_deg: prediction.as_ref().map_or(Vec::new(), |p| {
+                p.other_stable.iter().map(|o| o.phi0_deg).collect()
+            }),
             omega_p: live.omega_p,
             predicted_omega_p: prediction.as_ref().map(|p| p.omega_p),
             r_estimate: live.r_estimate,

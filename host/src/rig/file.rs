@@ -520,12 +520,22 @@ mod tests {
         assert_eq!(f.params.body, Some(Body { restitution: 0.8 }));
         let f = parse(&format!("{base}[body]\npresent = false\n")).unwrap();
         assert_eq!(f.params.body, None);
-        for bad in ["restitution = 1.5", "restitution = -0.1", "restitution = nan"] {
+        for bad in [
+            "restitution = 1.5",
+            "restitution = -0.1",
+            "restitution = nan",
+        ] {
             let e = parse(&format!("{base}[body]\n{bad}\n")).unwrap_err();
             let e = format!("{e:#}");
-            assert!(e.contains("body.restitution") && e.contains("[0, 1]"), "{e}");
+            assert!(
+                e.contains("body.restitution") && e.contains("[0, 1]"),
+                "{e}"
+            );
         }
-        let e = parse(&format!("{base}[body]\npresent = false\nrestitution = 0.5\n")).unwrap_err();
+        let e = parse(&format!(
+            "{base}[body]\npresent = false\nrestitution = 0.5\n"
+        ))
+        .unwrap_err();
         assert!(format!("{e:#}").contains("body.present = false"), "{e:#}");
         let e = parse(&format!("{base}[body]\nthere = 1\n")).unwrap_err();
         assert!(format!("{e:#}").contains("there"), "{e:#}");

@@ -86,7 +86,10 @@ mod tests {
             assert_eq!(Live::of(m, &frame(m)).slow_angle_deg, None);
         }
         // The status already says idle while the last frame still says running: idle.
-        assert_eq!(Live::of(Mode::Idle, &frame(Mode::Running)).slow_angle_deg, None);
+        assert_eq!(
+            Live::of(Mode::Idle, &frame(Mode::Running)).slow_angle_deg,
+            None
+        );
     }
 
     #[test]

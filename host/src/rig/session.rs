@@ -12,10 +12,10 @@ use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
 use serde::Serialize;
 
+use super::live::Live;
 use super::names::{fault_name, mode_name, reset_name, stop_name};
 use super::owner;
 use super::port::{self, ReadWrite, Target};
-use super::live::Live;
 use super::predicted::{predict, Prediction};
 use super::simhost::{SimOptions, SimPort};
 use super::{Exit, Failure};
@@ -207,7 +207,8 @@ impl StatusView {
         let r_target = cfg.r_for_omega(omega_target);
         let theta_d_target = from_q16(s.theta_d_target_deg);
         let live = t.map(|t| Live::of(s.mode, t));
-        let settled = t.is_some_and(|t| t.settled) && live.is_some_and(|l| l.slow_angle_deg.is_some());
+        let settled =
+            t.is_some_and(|t| t.settled) && live.is_some_and(|l| l.slow_angle_deg.is_some());
         let measured = live.and_then(|l| l.measured_deg);
         let predicted = (s.mode == Mode::Running && r_target > 0.0)
             .then(|| predict(cfg, r_target, theta_d_target, measured))
@@ -302,7 +303,11 @@ impl StatusView {
                 s += &format!(" (model: {:.3})", p.omega_p);
             }
         }
-        if let Some(p) = self.predicted.as_ref().filter(|p| !p.other_stable.is_empty()) {
+        if let Some(p) = self
+            .predicted
+            .as_ref()
+            .filter(|p| !p.other_stable.is_empty())
+        {
             let others: Vec<String> = p
                 .other_stable
                 .iter()
