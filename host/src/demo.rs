@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::monitor::{Command, Driver, State};
 use crate::outcome::show_deg;
-use crate::rig::predicted::predict;
+use crate::rig::predicted::{predict, Stable};
 
 /// Seconds of the rig's clock the rod hangs at rest before the first command.
 pub const REST_S: f64 = 3.0;
@@ -77,11 +77,15 @@ pub struct Measured {
     pub r: Option<f64>,
 }
 
+/// The stable equilibrium nearest the measured φ0 (`rig::predicted`), the others, and whether
+/// the measurement is outside reach.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Predicted {
     pub phi0_deg: Option<f64>,
     pub omega_p: Option<f64>,
     pub r: f64,
+    pub other_stable: Vec<Stable>,
+    pub outside_reach: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -103,6 +107,37 @@ enum Phase {
         since_s: f64,
     },
     Done,
+}
+
+/// The table of measured against predicted, one line per step under a header: 71 columns, so
+/// it fits the dashboard on an 80-column terminal as well as the terminal after it.
+pub fn table(rows: &[Outcome]) -> Vec<String> {
+    let show = |x: Option<f64>, prec: usize| x.map_or("—".into(), |v| format!("{v:.prec$}"));
+    let angle = |x: Option<f64>| x.map_or("—".into(), show_deg);
+    let mut lines = vec![format!(
+        "{:>5} {:>6} {:>8} {:>9} {:>9} {:>7} {:>7} {:>6} {:>6}",
+        "R", "θd (°)", "settle s", "φ0 meas", "φ0 pred", "ωp meas", "ωp pred", "R meas", "R req"
+    )];
+    for o in rows {
+        lines.push(format!(
+            "{:>5.2} {:>6.1} {:>8} {:>9} {:>9} {:>7} {:>7} {:>6} {:>6.3}{}",
+            o.r,
+            o.drive_angle_deg,
+            show(o.settle_s, 1),
+            angle(o.measured.phi0_deg),
+            angle(o.predicted.phi0_deg),
+            show(o.measured.omega_p, 3),
+            show(o.predicted.omega_p, 3),
+            show(o.measured.r, 3),
+            o.predicted.r,
+            if o.predicted.outside_reach {
+                "  outside reach"
+            } else {
+                ""
+            },
+        ));
+    }
+    lines
 }
 
 /// The demo's script: see the [module doc](self).
@@ -135,6 +170,12 @@ impl Script {
     fn abort(&mut self, state: &mut State, why: String) {
         state.note(format!("demo stopped: {why}"));
         self.aborted = Some(why);
+        self.done(state);
+    }
+
+    /// The end: the table stays on the dashboard.
+    fn done(&mut self, state: &mut State) {
+        state.summary = table(&self.outcomes);
         self.phase = Phase::Done;
     }
 
@@ -144,7 +185,6 @@ impl Script {
             return;
         };
         let (r_req, theta_d) = step.map_or((0.0, r.drive_angle_deg), |s| (s.r, s.theta_d_deg));
-        let p = predict(&cfg, r_req, theta_d);
         let measured = if step.is_some() {
             Measured {
                 phi0_deg: r.equilibrium_deg,
@@ -158,6 +198,7 @@ impl Script {
                 r: None,
             }
         };
+        let p = predict(&cfg, r_req, theta_d, measured.phi0_deg);
         let o = Outcome {
             r: r_req,
             drive_angle_deg: theta_d,
@@ -165,15 +206,17 @@ impl Script {
             settle_s: settled.then_some(state.t_s() - since_s),
             measured,
             predicted: Predicted {
-                phi0_deg: p.map(|p| p.phi0_deg),
-                omega_p: p.map(|p| p.omega_p),
+                phi0_deg: p.as_ref().map(|p| p.phi0_deg),
+                omega_p: p.as_ref().map(|p| p.omega_p),
                 r: r_req,
+                other_stable: p.as_ref().map_or(Vec::new(), |p| p.other_stable.clone()),
+                outside_reach: p.is_some_and(|p| p.outside_reach),
             },
         };
         let show = |x: Option<f64>, prec: usize| x.map_or("—".into(), |v| format!("{v:.prec$}"));
         let angle = |x: Option<f64>| x.map_or("—".into(), show_deg);
         state.note(format!(
-            "R = {} at θd = {}°: {} — φ0 {} (predicted {}), ωp {} ({}), R {}",
+            "R = {} at θd = {}°: {}",
             o.r,
             o.drive_angle_deg,
             match o.settle_s {
@@ -181,8 +224,16 @@ impl Script {
                 Some(_) => "at rest".into(),
                 None => "did not settle".into(),
             },
+        ));
+        state.note(format!(
+            "  φ0 {} (model {}{}), ωp {} ({}), R {}",
             angle(o.measured.phi0_deg),
             angle(o.predicted.phi0_deg),
+            if o.predicted.outside_reach {
+                "; OUTSIDE REACH"
+            } else {
+                ""
+            },
             show(o.measured.omega_p, 3),
             show(o.predicted.omega_p, 3),
             show(o.measured.r, 3),
@@ -269,7 +320,7 @@ impl Driver for Script {
                     } else {
                         "demo: done, but the drive has not run down"
                     });
-                    self.phase = Phase::Done;
+                    self.done(state);
                 }
                 None
             }

@@ -411,3 +411,77 @@ fn demo_script_waits_for_frames_after_its_command() {
     assert!(script.aborted.is_some());
     assert!(!script.outcomes[2].settled);
 }
+
+#[test]
+fn dashboard_fits_80_by_24() {
+    // A running rod settled at 55.15° (the predicted φ0 = arccos(1/1.75), physics §3), with
+    // the other stable one (−55.15°), ωp measured 6.130 against ω0 √(R − 1/R) = 8.329
+    // (physics §3, θd = 90°), and a long event line from the demo.
+    let mut s = running_state();
+    s.note("R = 1.75 at θd = 90°: settled after 12.3 s");
+    s.note("  φ0 55.20° (model 55.15°), ωp 5.800 (5.813), R 1.752 — and a tail that must wrap");
+    let text = screen(&s, 80, 24);
+    snapshot("monitor_80x24", &text);
+    // Every number a lecturer reads, whole: both panels' values, the prediction, the other
+    // stable equilibrium, the settled flag, the event's tail and the keys.
+    for want in [
+        "R",
+        "1.750",
+        "188.",
+        "90.0",
+        "55.15°",
+        "-55.15°",
+        "6.130",
+        "8.329",
+        "1.752",
+        "settled",
+        "must wrap",
+        "STOP the drive",
+        "clear fault",
+        "quit",
+    ] {
+        assert!(
+            text.contains(want),
+            "{want} cut from the 80×24 screen:\n{text}"
+        );
+    }
+    // The keys on the last row, the title on the first.
+    assert!(text.lines().last().unwrap().contains("STOP"), "{text}");
+    assert!(
+        text.lines().next().unwrap().contains("mode: running"),
+        "{text}"
+    );
+}
+
+#[test]
+fn idle_shows_the_live_angle_not_a_stale_one_nor_drive_changing() {
+    // The rig's last slow angle from a run (179.998°, an inverted rod that has since fallen)
+    // in an idle frame hanging at 0.0°.
+    let mut s = running_state();
+    s.on_event(Event::Status(status(Mode::Idle, 0.0, 90.0, 2)));
+    let idle = Telemetry {
+        mode: Mode::Idle,
+        theta: turns(0.0),
+        phi: turns(179.998),
+        steady: false,
+        ..frame(40.0, 179.998, 0.0, 90.0, 2)
+    };
+    s.on_event(Event::Telemetry(idle));
+    let r = s.readings().unwrap();
+    assert_eq!(r.slow_angle_deg, None);
+    assert_eq!(
+        (r.omega_p, r.r_estimate, r.equilibrium_deg),
+        (None, None, None)
+    );
+    assert!(!r.settled);
+    let text = screen(&s, 80, 24);
+    assert!(!text.contains("drive changing"), "{text}");
+    assert!(text.contains("drive idle"), "{text}");
+    assert!(
+        !text.contains("179.998") && !text.contains("180.00"),
+        "{text}"
+    );
+    // --plain's record: null, not the stale value.
+    let v = serde_json::to_value(&r).unwrap();
+    assert!(v["slow_angle_deg"].is_null(), "{v}");
+}

@@ -9,7 +9,6 @@ use crate::cmd::monitor::open_feed;
 use crate::cmd::rig_args::RigArgs;
 use crate::demo::{Outcome, Script, STEPS};
 use crate::monitor::{self, Options, Plain};
-use crate::outcome::show_deg;
 use crate::rig::port::Target;
 
 /// Run the lecture demo: the rod hanging at rest; R = 1.75 at θd = 90°, where it settles near
@@ -95,27 +94,8 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
 }
 
 fn print_table(rows: &[Outcome], out: &mut dyn Write) -> Result<()> {
-    let show = |x: Option<f64>, prec: usize| x.map_or("—".into(), |v| format!("{v:.prec$}"));
-    let angle = |x: Option<f64>| x.map_or("—".into(), show_deg);
-    writeln!(
-        out,
-        "{:>5} {:>7}  {:>9}  {:>9} {:>9}  {:>9} {:>9}  {:>7} {:>7}",
-        "R", "θd (°)", "settle s", "φ0 meas", "φ0 pred", "ωp meas", "ωp pred", "R meas", "R req"
-    )?;
-    for o in rows {
-        writeln!(
-            out,
-            "{:>5.2} {:>7.1}  {:>9}  {:>9} {:>9}  {:>9} {:>9}  {:>7} {:>7.3}",
-            o.r,
-            o.drive_angle_deg,
-            show(o.settle_s, 1),
-            angle(o.measured.phi0_deg),
-            angle(o.predicted.phi0_deg),
-            show(o.measured.omega_p, 3),
-            show(o.predicted.omega_p, 3),
-            show(o.measured.r, 3),
-            o.predicted.r,
-        )?;
+    for line in crate::demo::table(rows) {
+        writeln!(out, "{line}")?;
     }
     Ok(())
 }

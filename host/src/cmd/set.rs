@@ -339,16 +339,16 @@ fn stage(t: &Telemetry) -> &'static str {
 
 /// One line of what the rig does.
 fn progress_line(t: &Telemetry) -> String {
-    use crate::rig::names::turns_deg;
-    let phi = match (t.settled, t.equilibrium) {
-        (true, Some(e)) => turns_deg(e),
-        _ => turns_deg(t.phi),
+    use crate::rig::live::Live;
+    let live = Live::of(t.mode, t);
+    let angle = match live.slow_angle_deg {
+        Some(phi) => format!("φ = {phi:.1}°"),
+        None => format!("θ = {:.1}°", live.theta_deg),
     };
     format!(
-        "  ω = {:.0} rad/s, θd = {:.0}°, φ = {:.1}°, {}",
+        "  ω = {:.0} rad/s, θd = {:.0}°, {angle}, {}",
         from_q16(t.omega),
         from_q16(t.theta_d_deg),
-        phi,
         stage(t)
     )
 }

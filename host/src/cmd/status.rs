@@ -12,8 +12,8 @@ pub struct Args {
     #[command(flatten)]
     pub rig: RigArgs,
     /// One JSON object: mode, fault, r_target, omega, omega_target, drive_angle_deg,
-    /// drive_angle_target_deg, slow_angle_deg, omega_p, r_estimate, settled, predicted, commands,
-    /// counters.
+    /// drive_angle_target_deg, theta_deg, slow_angle_deg, omega_p, r_estimate (null unless the
+    /// drive runs), settled, predicted (with other_stable, outside_reach), commands, counters.
     #[arg(long)]
     pub json: bool,
 }

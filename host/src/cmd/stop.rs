@@ -4,7 +4,10 @@ use std::io::Write;
 
 use anyhow::Result;
 
+use kapitza_core::link::message::Mode;
+
 use super::rig_args::RigArgs;
+use crate::rig::names::fault_name;
 
 /// Soft-stop the drive (ramped down at the rate limit; an inverted pendulum falls gently).
 #[derive(Debug, clap::Args)]
@@ -27,9 +30,16 @@ pub fn stop(args: &StopArgs, out: &mut dyn Write) -> Result<()> {
     Ok(())
 }
 
+/// Asks the rig first: with no fault latched there is nothing to send, and the rig is left as
+/// it is.
 pub fn clear(args: &ClearArgs, out: &mut dyn Write) -> Result<()> {
     let mut s = args.rig.connect()?;
+    let status = s.call(|c| c.status())?;
+    let Mode::Faulted(f) = status.mode else {
+        writeln!(out, "{}: no fault to clear", s.name)?;
+        return Ok(());
+    };
     s.call(|c| c.clear_fault())?;
-    writeln!(out, "{}: fault cleared", s.name)?;
+    writeln!(out, "{}: fault cleared ({})", s.name, fault_name(&f))?;
     Ok(())
 }

@@ -5,7 +5,7 @@
 //! title: link, mode, fault
 //! drive: R, ω, θd — set point against actual   │  pendulum: φ against the predicted φ0,
 //!                                              │  ωp and R measured against predicted, settled
-//! chart: the slow angle φ and the predicted φ0 over the last minute
+//! chart: the slow angle φ and the predicted φ0 over the last minute (at a demo's end, its table)
 //! event log
 //! keys: s stop (always shown), c clear fault, q quit
 //! ```
@@ -46,8 +46,24 @@ pub fn draw(frame: &mut Frame, state: &State) {
         Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(panels);
     frame.render_widget(drive_panel(readings.as_ref()), drive);
     frame.render_widget(pendulum_panel(readings.as_ref()), pendulum);
-    draw_chart(frame, chart, state);
-    frame.render_widget(log_panel(state, log.height.saturating_sub(2)), log);
+    if state.summary.is_empty() {
+        draw_chart(frame, chart, state);
+    } else {
+        let lines: Vec<Line> = state
+            .summary
+            .iter()
+            .map(|l| Line::from(format!(" {l}")))
+            .collect();
+        let title = " measured against predicted (q to leave) ";
+        frame.render_widget(
+            Paragraph::new(lines).block(Block::bordered().title(title)),
+            chart,
+        );
+    }
+    frame.render_widget(
+        log_panel(state, log.height.saturating_sub(2), log.width),
+        log,
+    );
     frame.render_widget(key_line(), keys);
 }
 
@@ -56,7 +72,7 @@ fn title_line(state: &State, r: Option<&Readings>) -> Paragraph<'static> {
         Link::Waiting => Span::styled("waiting for the rig", Style::new().fg(Color::Yellow)),
         Link::Up { protocol, firmware } => Span::styled(
             format!(
-                "up (protocol {protocol}, firmware {}.{}.{})",
+                "up (v{protocol}, fw {}.{}.{})",
                 firmware[0], firmware[1], firmware[2]
             ),
             Style::new().fg(Color::Green),
@@ -89,13 +105,14 @@ fn title_line(state: &State, r: Option<&Readings>) -> Paragraph<'static> {
     Paragraph::new(Line::from(spans))
 }
 
+/// One row of a panel: 33 columns, so both panels fit side by side in 80.
 fn row(label: &str, set: String, actual: String) -> Line<'static> {
-    Line::from(format!(" {label:<14}{set:>10} {actual:>10}"))
+    Line::from(format!(" {label:<13}{set:>9} {actual:>9}"))
 }
 
 fn drive_panel(r: Option<&Readings>) -> Paragraph<'static> {
     let lines = vec![
-        Line::from(format!(" {:<14}{:>10} {:>10}", "", "set", "now")).style(dim()),
+        row("", "set".into(), "now".into()).style(dim()),
         row(
             "R",
             num(r.and_then(|r| r.r_target), 3),
@@ -138,17 +155,32 @@ pub fn closed_loop(c: Option<ClosedLoopR>) -> String {
 }
 
 fn pendulum_panel(r: Option<&Readings>) -> Paragraph<'static> {
+    let warn = Style::new().fg(Color::Red).add_modifier(Modifier::BOLD);
     let settled = match r {
+        Some(r) if r.mode != "running" => Span::raw(format!("drive {}", r.mode)),
+        Some(r) if r.outside_reach => Span::styled("OUTSIDE REACH (>90° from blade)", warn),
         Some(r) if r.settled => Span::styled("settled", Style::new().fg(Color::Green)),
         Some(r) if r.steady => Span::raw("settling"),
         Some(_) => Span::raw("drive changing"),
         None => Span::raw("—"),
     };
+    let others = r.map_or(String::new(), |r| {
+        r.other_stable_deg
+            .iter()
+            .map(|&d| show_deg(d))
+            .collect::<Vec<_>>()
+            .join(", ")
+    });
+    let mut status = vec![Span::raw(" "), settled];
+    if !others.is_empty() {
+        status.push(Span::styled(format!("  also stable {others}"), dim()));
+    }
     let lines = vec![
-        Line::from(format!(" {:<14}{:>10} {:>10}", "", "measured", "predicted")).style(dim()),
+        row("", "measured".into(), "predicted".into()).style(dim()),
+        row("θ now", angle(r.map(|r| r.theta_deg)), String::new()),
         row(
             "φ slow",
-            angle(r.map(|r| r.slow_angle_deg)),
+            angle(r.and_then(|r| r.slow_angle_deg)),
             angle(r.and_then(|r| r.predicted_phi0_deg)),
         ),
         row(
@@ -166,7 +198,7 @@ fn pendulum_panel(r: Option<&Readings>) -> Paragraph<'static> {
             num(r.and_then(|r| r.r_estimate), 3),
             num(r.and_then(|r| r.r_target), 3),
         ),
-        Line::from(vec![Span::raw(" "), settled]),
+        Line::from(status),
     ];
     Paragraph::new(lines).block(Block::bordered().title(" pendulum "))
 }
@@ -230,15 +262,27 @@ fn angle_bounds(points: impl Iterator<Item = f64>) -> (f64, f64) {
     ((lo / 5.0).floor() * 5.0, (hi / 5.0).ceil() * 5.0)
 }
 
-fn log_panel(state: &State, rows: u16) -> Paragraph<'static> {
-    let skip = state.log.len().saturating_sub(usize::from(rows));
-    let lines: Vec<Line> = state
-        .log
-        .iter()
-        .skip(skip)
-        .map(|(t, text)| Line::from(format!(" {t:8.2} s  {text}")))
-        .collect();
-    Paragraph::new(lines).block(Block::bordered().title(" events "))
+/// The event log's last lines, each wrapped to the pane's width under its time stamp (so a long
+/// line loses nothing).
+fn log_panel(state: &State, rows: u16, width: u16) -> Paragraph<'static> {
+    const STAMP: usize = 12;
+    let text_w = usize::from(width.saturating_sub(2))
+        .saturating_sub(STAMP)
+        .max(10);
+    let mut lines: Vec<Line> = Vec::new();
+    for (t, text) in &state.log {
+        let chars: Vec<char> = text.chars().collect();
+        for (k, part) in chars.chunks(text_w).enumerate() {
+            let part: String = part.iter().collect();
+            lines.push(Line::from(if k == 0 {
+                format!(" {t:7.1} s  {part}")
+            } else {
+                format!("{:STAMP$}{part}", "")
+            }));
+        }
+    }
+    let skip = lines.len().saturating_sub(usize::from(rows));
+    Paragraph::new(lines.split_off(skip)).block(Block::bordered().title(" events "))
 }
 
 fn key_line() -> Paragraph<'static> {

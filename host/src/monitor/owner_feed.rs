@@ -10,11 +10,35 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use kapitza_core::link::convert::to_q16;
+use kapitza_core::link::convert::{from_q16, to_q16};
 use kapitza_core::link::{Request, Response};
 
 use super::feed::{Command, Event, Feed};
 use crate::rig::owner::{self, Owner};
+
+/// A request relayed from another terminal, as the event log shows it; `None` for the routine
+/// traffic of every one-shot command (version, status, configuration read, telemetry stream),
+/// which would push the events out of the pane.
+fn relayed(req: &Request) -> Option<String> {
+    Some(match req {
+        Request::GetVersion
+        | Request::GetStatus
+        | Request::GetConfig
+        | Request::Telemetry { .. } => return None,
+        Request::SetDrive { r, theta_d_deg } if *r == 0 => {
+            format!("stop (R = 0, θd = {:.1}°)", from_q16(*theta_d_deg))
+        }
+        Request::SetDrive { r, theta_d_deg } => format!(
+            "set R = {:.3}, θd = {:.1}°",
+            from_q16(*r),
+            from_q16(*theta_d_deg)
+        ),
+        Request::Stop => "stop".into(),
+        Request::ClearFault => "clear fault".into(),
+        Request::SetConfig(_) => "new configuration".into(),
+        other => format!("{other:?}"),
+    })
+}
 
 type Reply = Sender<Result<(), String>>;
 
@@ -83,9 +107,10 @@ impl OwnerFeed {
                             Some(e) => e,
                             None => continue,
                         },
-                        owner::Event::Relayed(req) => {
-                            Event::Note(format!("from another terminal: {req:?}"))
-                        }
+                        owner::Event::Relayed(req) => match relayed(&req) {
+                            Some(what) => Event::Note(format!("from another terminal: {what}")),
+                            None => continue,
+                        },
                     };
                     if ev_tx.send(ev).is_err() {
                         // Nobody is watching any more: the rig's own timeout backs the stop.
@@ -147,5 +172,32 @@ impl Feed for OwnerFeed {
 impl Drop for OwnerFeed {
     fn drop(&mut self) {
         let _ = self.close();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn routine_requests_stay_out_of_the_event_log() {
+        for r in [
+            Request::GetVersion,
+            Request::GetStatus,
+            Request::GetConfig,
+            Request::Telemetry { period_ms: 20 },
+        ] {
+            assert_eq!(relayed(&r), None, "{r:?}");
+        }
+        let set = Request::SetDrive {
+            r: to_q16(1.75),
+            theta_d_deg: to_q16(80.0),
+        };
+        assert_eq!(relayed(&set).as_deref(), Some("set R = 1.750, θd = 80.0°"));
+        assert_eq!(relayed(&Request::Stop).as_deref(), Some("stop"));
+        assert_eq!(
+            relayed(&Request::ClearFault).as_deref(),
+            Some("clear fault")
+        );
     }
 }

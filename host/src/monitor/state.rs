@@ -13,7 +13,8 @@ use kapitza_core::link::{Status, Telemetry};
 use kapitza_core::rig::config::RigConfig;
 
 use super::feed::{Command, Event};
-use crate::rig::names::{fault_name, mode_name, turns_deg};
+use crate::rig::live::Live;
+use crate::rig::names::{fault_name, mode_name};
 use crate::rig::predicted::predict;
 
 /// Seconds of slow angle the chart keeps.
@@ -70,12 +71,19 @@ pub struct Readings {
     /// θd now and its target (degrees along the mount's travel).
     pub drive_angle_deg: f64,
     pub drive_angle_target_deg: Option<f64>,
-    /// The latest pendulum sample θ and the slow angle φ, degrees in (−180, 180].
+    /// The latest pendulum sample θ and the slow angle φ, degrees in (−180, 180]; φ only while
+    /// the drive runs (`rig::live`).
     pub theta_deg: f64,
-    pub slow_angle_deg: f64,
-    /// φ0 once settled, and the averaged theory's φ0 at the present R and θd.
+    pub slow_angle_deg: Option<f64>,
+    /// φ0 once settled, and the averaged theory's stable φ0 at the present R and θd nearest the
+    /// measured slow angle (before one is measured, the one within reach).
     pub equilibrium_deg: Option<f64>,
     pub predicted_phi0_deg: Option<f64>,
+    /// The measured slow angle lies more than 90° from the blade (no body, a sensor zero off).
+    pub outside_reach: bool,
+    /// The other stable equilibria at the present R and θd (degrees).
+    #[serde(skip)]
+    pub other_stable_deg: Vec<f64>,
     /// ωp measured and predicted (rad/s).
     pub omega_p: Option<f64>,
     pub predicted_omega_p: Option<f64>,
@@ -121,6 +129,9 @@ pub struct State {
     /// Lines ever logged (the log drops old ones; writers of new lines count on this).
     pub logged: u64,
     pub quit: bool,
+    /// A result table a driver leaves on the dashboard in place of the chart (the demo's, at
+    /// its end); empty: the chart.
+    pub summary: Vec<String>,
     /// Rig µs since the first frame (summed exactly), and the rig's µs clock at the last frame
     /// (`None`: take the next frame as the base, as after a reconnect to a rig whose clock
     /// restarted).
@@ -147,6 +158,7 @@ impl State {
             log: VecDeque::new(),
             logged: 0,
             quit: false,
+            summary: Vec::new(),
             elapsed_us: 0,
             last_us: None,
             commands_seen: 0,
@@ -216,7 +228,7 @@ impl State {
         self.set_mode(t.mode);
         self.telemetry = Some(t);
         let Some(r) = self.readings() else { return };
-        if r.settled && !was_settled {
+        if r.settled && !was_settled && r.slow_angle_deg.is_some() {
             let at = r
                 .equilibrium_deg
                 .map_or("—".into(), crate::outcome::show_deg);
@@ -224,7 +236,7 @@ impl State {
         }
         self.history.push_back(Point {
             t_s: r.t_s,
-            phi_deg: chart_deg(r.slow_angle_deg),
+            phi_deg: chart_deg(r.slow_angle_deg.unwrap_or(r.theta_deg)),
             predicted_deg: r.predicted_phi0_deg.map(chart_deg),
         });
         while self
@@ -279,10 +291,11 @@ impl State {
         let omega_target = self.status.map(|s| from_q16(s.omega_target));
         let drive_angle_deg = from_q16(t.theta_d_deg);
         let r = cfg.map(|c| c.r_for_omega(omega));
+        let mode = self.mode.unwrap_or(t.mode);
+        let live = Live::of(mode, &t);
         let prediction = cfg
             .zip(r)
-            .and_then(|(c, r)| predict(&c, r, drive_angle_deg));
-        let mode = self.mode.unwrap_or(t.mode);
+            .and_then(|(c, r)| predict(&c, r, drive_angle_deg, live.measured_deg));
         Some(Readings {
             t_s: self.t_s(),
             mode: mode_name(&mode),
@@ -294,14 +307,21 @@ impl State {
             crank_speed: from_q16(t.crank_speed),
             drive_angle_deg,
             drive_angle_target_deg: self.status.map(|s| from_q16(s.theta_d_target_deg)),
-            theta_deg: turns_deg(t.theta),
-            slow_angle_deg: turns_deg(t.phi),
-            equilibrium_deg: t.equilibrium.map(turns_deg),
-            predicted_phi0_deg: prediction.map(|p| p.phi0_deg),
-            omega_p: t.omega_p.map(from_q16),
-            predicted_omega_p: prediction.map(|p| p.omega_p),
-            r_estimate: t.r.map(|(r, _)| from_q16(r)),
-            settled: t.settled,
+            theta_deg: live.theta_deg,
+            slow_angle_deg: live.slow_angle_deg,
+            equilibrium_deg: live
+                .slow_angle_deg
+                .and(t.equilibrium)
+                .map(crate::rig::names::turns_deg),
+            predicted_phi0_deg: prediction.as_ref().map(|p| p.phi0_deg),
+            outside_reach: prediction.as_ref().is_some_and(|p| p.outside_reach),
+            other_stable_deg: prediction.as_ref().map_or(Vec::new(), |p| {
+                p.other_stable.iter().map(|o| o.phi0_deg).collect()
+            }),
+            omega_p: live.omega_p,
+            predicted_omega_p: prediction.as_ref().map(|p| p.omega_p),
+            r_estimate: live.r_estimate,
+            settled: t.settled && live.slow_angle_deg.is_some(),
             steady: t.steady,
             commands: t.commands,
             closed_loop: cfg.map(|c| c.closed_loop),

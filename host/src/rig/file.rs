@@ -12,6 +12,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Context, Result};
 use kapitza_core::math;
 use kapitza_core::rig::config::RigConfig;
+use kapitza_core::simrig::body::Body;
 use kapitza_core::simrig::plant::MotorModel;
 use kapitza_core::simrig::sensor::Line;
 use kapitza_core::simrig::Params;
@@ -100,6 +101,8 @@ struct RawRig {
     initial: RawInitial,
     #[serde(default)]
     operator: RawOperator,
+    #[serde(default)]
+    body: RawBody,
     seed: Option<u64>,
     configured: Option<RawConfigured>,
 }
@@ -147,6 +150,17 @@ struct RawSliderCrank {
 #[serde(deny_unknown_fields, expecting = "a table: [operator] release_deg = …")]
 struct RawOperator {
     release_deg: Option<f64>,
+}
+
+/// `[body]`: the actuator's body that keeps the rod within 90° of the blade (`simrig::body`).
+#[derive(Debug, Default, Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a table: [body] present = true/false, restitution = …"
+)]
+struct RawBody {
+    present: Option<bool>,
+    restitution: Option<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -303,6 +317,25 @@ fn sign(reversed: bool) -> f64 {
     }
 }
 
+/// The body, unless `present = false`; a restitution given for an absent body is refused
+/// rather than ignored.
+fn body(raw: &RawBody) -> Result<Option<Body>> {
+    let restitution = match raw.restitution {
+        Some(e) => Some(in_range("body.restitution", e, 0.0, 1.0, "in [0, 1]")?),
+        None => None,
+    };
+    match (raw.present.unwrap_or(true), restitution) {
+        (true, e) => Ok(Some(Body {
+            restitution: e.unwrap_or(Body::DEFAULT.restitution),
+        })),
+        (false, None) => Ok(None),
+        (false, Some(e)) => bail!(
+            "body.restitution = {e} given with body.present = false: a rig without a body has no \
+             contact (drop one of the two)"
+        ),
+    }
+}
+
 fn convert(raw: RawRig) -> Result<RigFile> {
     let geometry = pendulum(&raw.pendulum)?;
     let gravity = positive("environment.gravity", raw.environment.gravity)?;
@@ -419,6 +452,7 @@ fn convert(raw: RawRig) -> Result<RigFile> {
             )?)),
             None => None,
         },
+        body: body(&raw.body)?,
         seed: raw.seed.unwrap_or(1),
     };
     let mut config = params.configured();
@@ -507,6 +541,35 @@ mod tests {
         )
         .unwrap_err();
         assert!(format!("{e:#}").contains("crank_sign"), "{e:#}");
+    }
+
+    #[test]
+    fn the_body_is_there_unless_the_file_says_not() {
+        let base = "[pendulum]\ngeometry = \"rod\"\nlength = 0.25\n[drive]\namplitude = 0.0127\n";
+        assert_eq!(parse(base).unwrap().params.body, Some(Body::DEFAULT));
+        let f = parse(&format!("{base}[body]\nrestitution = 0.8\n")).unwrap();
+        assert_eq!(f.params.body, Some(Body { restitution: 0.8 }));
+        let f = parse(&format!("{base}[body]\npresent = false\n")).unwrap();
+        assert_eq!(f.params.body, None);
+        for bad in [
+            "restitution = 1.5",
+            "restitution = -0.1",
+            "restitution = nan",
+        ] {
+            let e = parse(&format!("{base}[body]\n{bad}\n")).unwrap_err();
+            let e = format!("{e:#}");
+            assert!(
+                e.contains("body.restitution") && e.contains("[0, 1]"),
+                "{e}"
+            );
+        }
+        let e = parse(&format!(
+            "{base}[body]\npresent = false\nrestitution = 0.5\n"
+        ))
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("body.present = false"), "{e:#}");
+        let e = parse(&format!("{base}[body]\nthere = 1\n")).unwrap_err();
+        assert!(format!("{e:#}").contains("there"), "{e:#}");
     }
 
     #[test]

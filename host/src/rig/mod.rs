@@ -7,6 +7,7 @@
 //! | [`fields`] | the core's safety table with each field's key, unit and reason: the checks before sending, `config_fallbacks`, docs/rig.md's table |
 //! | [`file`] | rig files: a simulated rig's true physics and the configuration it is given |
 //! | [`simhost`] | a simulated rig against the wall clock (real time × speed), on any line |
+//! | [`live`] | which of the estimator's numbers describe the pendulum now (never a frozen one) |
 //! | [`predicted`] | what the model expects of the configured pendulum at a drive (the `predict` code) |
 //! | [`session`] | a checked connection (version, configuration) and the rig's state in user units |
 //! | [`names`] | modes, faults and stop reasons as every output names them; wire angles in degrees |
@@ -20,6 +21,7 @@
 
 pub mod fields;
 pub mod file;
+pub mod live;
 pub mod names;
 pub mod owner;
 pub mod port;

@@ -12,7 +12,8 @@ use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::config::RigConfig;
 use serde::Serialize;
 
-use super::names::{fault_name, mode_name, reset_name, stop_name, turns_deg};
+use super::live::Live;
+use super::names::{fault_name, mode_name, reset_name, stop_name};
 use super::owner;
 use super::port::{self, ReadWrite, Target};
 use super::predicted::{predict, Prediction};
@@ -169,14 +170,20 @@ pub struct StatusView {
     pub omega_target: f64,
     pub drive_angle_deg: f64,
     pub drive_angle_target_deg: f64,
-    /// The estimator's slow angle φ (the settled equilibrium once settled), degrees.
+    /// The latest pendulum sample θ, degrees: what stands in for the slow angle while there is
+    /// none.
+    pub theta_deg: Option<f64>,
+    /// The estimator's slow angle φ (the settled equilibrium once settled), degrees; only
+    /// while the drive runs ([`Live`]).
     pub slow_angle_deg: Option<f64>,
-    /// Slow-oscillation frequency ωp (rad/s), once measured.
+    /// Slow-oscillation frequency ωp (rad/s), once measured, while the drive runs.
     pub omega_p: Option<f64>,
-    /// R in situ, once settled.
+    /// R in situ, once settled, while the drive runs.
     pub r_estimate: Option<f64>,
     pub settled: bool,
-    /// The model's φ0 and ωp for `r_target` and `drive_angle_target_deg` (while running).
+    /// While running: the model's stable φ0 nearest the measured slow angle (before one is
+    /// measured, the one within reach) for `r_target` and `drive_angle_target_deg`, with the
+    /// other stable ones and whether the measurement is outside reach.
     pub predicted: Option<Prediction>,
     /// Commands the rig has carried out since power-up.
     pub commands: u32,
@@ -212,13 +219,12 @@ impl StatusView {
         let omega_target = from_q16(s.omega_target);
         let r_target = cfg.r_for_omega(omega_target);
         let theta_d_target = from_q16(s.theta_d_target_deg);
-        let settled = t.is_some_and(|t| t.settled);
-        let slow = t.map(|t| match (t.settled, t.equilibrium) {
-            (true, Some(e)) => turns_deg(e),
-            _ => turns_deg(t.phi),
-        });
+        let live = t.map(|t| Live::of(s.mode, t));
+        let settled =
+            t.is_some_and(|t| t.settled) && live.is_some_and(|l| l.slow_angle_deg.is_some());
+        let measured = live.and_then(|l| l.measured_deg);
         let predicted = (s.mode == Mode::Running && r_target > 0.0)
-            .then(|| predict(cfg, r_target, theta_d_target))
+            .then(|| predict(cfg, r_target, theta_d_target, measured))
             .flatten();
         Self {
             mode: mode_name(&s.mode),
@@ -233,9 +239,10 @@ impl StatusView {
             omega_target,
             drive_angle_deg: from_q16(s.theta_d_deg),
             drive_angle_target_deg: theta_d_target,
-            slow_angle_deg: slow,
-            omega_p: t.and_then(|t| t.omega_p).map(from_q16),
-            r_estimate: t.and_then(|t| t.r).map(|(r, _)| from_q16(r)),
+            theta_deg: live.map(|l| l.theta_deg),
+            slow_angle_deg: live.and_then(|l| l.slow_angle_deg),
+            omega_p: live.and_then(|l| l.omega_p),
+            r_estimate: live.and_then(|l| l.r_estimate),
             settled,
             predicted,
             commands: s.counters.commands,
@@ -291,20 +298,42 @@ impl StatusView {
             self.drive_angle_deg,
             self.drive_angle_target_deg
         );
-        if let Some(phi) = self.slow_angle_deg {
-            s += &format!(
-                "\npendulum    φ = {phi:.2}°{}",
-                if self.settled { ", settled" } else { "" }
-            );
-            if let Some(p) = self.predicted {
-                s += &format!(" (model: {:.2}°)", p.phi0_deg);
+        match (self.slow_angle_deg, self.theta_deg) {
+            (Some(phi), _) => {
+                s += &format!(
+                    "\npendulum    φ = {phi:.2}°{}",
+                    if self.settled { ", settled" } else { "" }
+                );
+                if let Some(p) = &self.predicted {
+                    s += &format!(" (model: {:.2}°)", p.phi0_deg);
+                    if p.outside_reach {
+                        s += ", outside reach: more than 90° from the blade (no body, or the \
+                               sensor's zero off?)";
+                    }
+                }
             }
+            (None, Some(theta)) => {
+                s += &format!("\npendulum    θ = {theta:.2}° (slow angle, ωp, R in situ: —, the drive is not running)")
+            }
+            (None, None) => {}
         }
         if let Some(w) = self.omega_p {
             s += &format!("\n            ωp = {w:.3} rad/s");
-            if let Some(p) = self.predicted {
+            if let Some(p) = &self.predicted {
                 s += &format!(" (model: {:.3})", p.omega_p);
             }
+        }
+        if let Some(p) = self
+            .predicted
+            .as_ref()
+            .filter(|p| !p.other_stable.is_empty())
+        {
+            let others: Vec<String> = p
+                .other_stable
+                .iter()
+                .map(|o| format!("{:.2}° (ωp {:.3})", o.phi0_deg, o.omega_p))
+                .collect();
+            s += &format!("\n            also stable: {}", others.join(", "));
         }
         if let Some(r) = self.r_estimate {
             s += &format!(

@@ -243,7 +243,9 @@ pub(crate) mod tests {
     use crate::simrig::Params;
 
     /// `rigs/mistyped.toml`'s bench: a 0.25 m rod typed in as 0.26 m, Q = 10, Coulomb
-    /// μ = 0.3 rad/s², the sensor's zero 1.5° off, 0.05° of noise; let go from `release`.
+    /// μ = 0.3 rad/s², the sensor's zero 1.5° off, 0.05° of noise, no actuator body (the
+    /// stroke's drive across the hanging rod would leave it on the body's face); let go from
+    /// `release`.
     pub(crate) fn mistyped(release_deg: f64, q: f64, mu: f64, sign: f64) -> (Params, RigConfig) {
         let omega0 = math::sqrt(9.81 / (2.0 * 0.25 / 3.0));
         let p = Params {
@@ -255,6 +257,7 @@ pub(crate) mod tests {
             connecting_rod: Some(0.06),
             servo_offset_deg: 2.0,
             theta0: math::to_rad(release_deg),
+            body: None,
             ..Params::DEMO
         };
         let cfg = RigConfig {

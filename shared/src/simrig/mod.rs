@@ -7,6 +7,7 @@
 //! | [`plant`] | the pendulum driven by the crank's actual angle, the DC motor, friction |
 //! | [`sensor`] | the pendulum sensor's chip behind its SPI pins (AS5047P), with its faults |
 //! | [`hand`] | a lab hand that lifts and lets go of the pendulum when calibration asks for it |
+//! | [`body`] | the actuator's body: the rod stays within 90° of the blade, a lossy contact |
 //!
 //! ```text
 //! every sample period h = 1/fs:
@@ -14,7 +15,8 @@
 //!             through the firmware's driver (rig::as5047) → Sample
 //!   RigLoop::sample; when due RigLoop::control(crank counts, motor current, e-stop)
 //!                    → duty (0 while the bridge sleeps), θd for the servo
-//!   servo slews the mount toward θd at its own rate;  plant: one RK4 step of h
+//!   servo slews the mount toward θd at its own rate;  plant: one RK4 step of h;
+//!   the body (if any) keeps the rod within 90° of the blade
 //! ```
 //! The true parameters ([`Params`]) may differ from the configuration the rig was given, the
 //! way a real rig differs from what was typed in: the hidden ones (sensor zero and sign, crank
@@ -25,6 +27,7 @@
 //! *configured* calibration, so a mis-calibrated configuration is visibly off.
 //! Everything is deterministic under [`Params::seed`].
 
+pub mod body;
 pub mod hand;
 pub mod plant;
 pub mod sensor;
@@ -43,6 +46,7 @@ use crate::sim::noise::Noise;
 use crate::station::drive::Drive;
 use crate::station::serve::Activity;
 use crate::station::{RigLoop, Sample};
+use body::Body;
 use hand::Hand;
 use plant::{MotorModel, Plant};
 use sensor::{Chip, Line};
@@ -87,13 +91,15 @@ pub struct Params {
     /// pendulum to and lets go from whenever the rig enters bring-up mode with the motor off;
     /// `None`: nobody at the rig.
     pub hand: Option<f64>,
+    /// The actuator's body ([`body`]); `None`: a rig without one, where the rod swings freely.
+    pub body: Option<Body>,
     pub seed: u64,
 }
 
 impl Params {
     /// The demo rod of physics §4 (L = 0.25 m, A = 12.7 mm), damped to Q = 10 (c = ω0/Q with
     /// ω0 = √(3g/2L) = 7.672 rad/s), on the default motor, a quiet sensor (0.02°) and a fast
-    /// servo, hanging at rest.
+    /// servo, hanging at rest, its actuator's body in place.
     pub const DEMO: Self = Self {
         geometry: Geometry::Rod { length: 0.25 },
         gravity: 9.81,
@@ -113,6 +119,7 @@ impl Params {
         sensor_line: Line::Connected,
         theta0: 0.0,
         hand: None,
+        body: Some(Body::DEFAULT),
         seed: 1,
     };
 
@@ -192,6 +199,9 @@ impl SimRig {
             params,
         };
         s.chip.line = params.sensor_line;
+        if let Some(body) = &params.body {
+            body.contact(&mut s.y, s.plant.theta_d, 0.0);
+        }
         // Prime the sensor's pipeline as the firmware does at power-up: the first answer
         // belongs to no command.
         s.chip.angle = s.sensor_code();
@@ -256,8 +266,13 @@ impl SimRig {
             }
         }
         let h = 1.0 / f64::from(self.rig.sample_hz());
+        let theta_d_before = self.plant.theta_d;
         self.slew_servo(h);
         self.y = rk4_step(&self.plant, self.seconds(), &self.y, h, &mut self.stats);
+        if let Some(body) = &self.params.body {
+            let rate = (self.plant.theta_d - theta_d_before) / h;
+            body.contact(&mut self.y, self.plant.theta_d, rate);
+        }
         self.lend_a_hand();
         self.k += 1;
     }
