@@ -8,9 +8,9 @@
 //! [`Reason`]; nothing changed).
 //!
 //! **Retries, exactly once.** A call sends its request and waits for the answer with the
-//! request's seq. Without one within the per-try timeout, or when the rig says it could not read
-//! the frame, or a damaged frame arrives (it may have been the answer), the same frame — the
-//! same seq — is sent again. The rig answers a repeat from the answer it already gave without
+//! request's seq. Without one within the per-try timeout the same frame — the same seq — is
+//! sent again; so it is at once when the rig says it could not read the frame, or a damaged
+//! frame arrives (it may have been the answer), without waiting the try out. The rig answers a repeat from the answer it already gave without
 //! carrying it out again (`kapitza_core::station::repeat`), so a command whose answer was lost
 //! is carried out once and still answered; an answer to any copy is taken. A refusal is never
 //! retried. The version handshake ([`Client::version`]) is a call like any other, so opening
@@ -21,9 +21,11 @@
 //! | per-try timeout | [`ANSWER_TIMEOUT`] = 40 ms (a round trip of the largest frames at 115200 baud, behind the telemetry queued before it, is about 55 ms: an answer later than the try is still taken) |
 //! | tries | [`TRIES`] = 25 |
 //! | retry window | tries × per-try timeout = 1 s, then the line has failed ([`LineError::Timeout`] or the last link-level reason) |
+//! | copies sent | at most [`MAX_SENDS_PER_TRY`] × tries = 100 in the window (damaged answers asked again at once) |
 //!
 //! On the line the tests damage (3 bytes in 400), a 170-byte configuration answer arrives
-//! whole about one time in four; 25 tries leave a call failing about once in 2000 (0.74^25).
+//! whole about one time in four; a round trip over a pseudo-terminal takes a few ms, so the
+//! window holds dozens of tries and a call fails only when the machine stalls it.
 //!
 //! The port's `read` should return within a few milliseconds when no byte arrives (a serial
 //! port's read timeout, `Ok(0)`, `TimedOut` or `WouldBlock`).
@@ -85,8 +87,11 @@ impl std::error::Error for Error {}
 
 /// How long one try waits for its answer before the request is sent again.
 pub const ANSWER_TIMEOUT: Duration = Duration::from_millis(40);
-/// How many times a request is sent before the line is reported as failed.
+/// How many per-try timeouts make the retry window.
 pub const TRIES: u32 = 25;
+/// A damaged answer is asked for again at once, without waiting its try out: at most this many
+/// copies per try in the window, a bound on what a call sends.
+pub const MAX_SENDS_PER_TRY: u32 = 4;
 
 /// A connection to a rig.
 pub struct Client<P> {
@@ -263,8 +268,10 @@ impl<P: Read + Write> Client<P> {
         }
     }
 
-    /// Sends `req` and waits for its answer, sending the same frame again (the same seq) on a
-    /// timeout, a link-level refusal or a damaged frame, up to `tries` times.
+    /// Sends `req` and waits for its answer, sending the same frame again (the same seq) after
+    /// a per-try timeout without it, and at once on a link-level refusal or a damaged frame,
+    /// until the retry window (tries × per-try timeout) is over or [`MAX_SENDS_PER_TRY`] × tries
+    /// copies are out.
     fn call(&mut self, req: Request) -> Result<Response, Error> {
         // seq 0 is what the rig answers a frame it could not read with; never ours.
         self.seq = self.seq.wrapping_add(1).max(1);
@@ -272,12 +279,13 @@ impl<P: Read + Write> Client<P> {
         let n = encode(Header::new(self.seq), &req, &mut frame)
             .map_err(|_| Error::Invalid("request larger than a frame"))?;
         let mut last = LineError::Timeout;
-        for _ in 0..self.tries {
+        let window = Instant::now() + self.window();
+        for _ in 0..self.tries.saturating_mul(MAX_SENDS_PER_TRY) {
             self.port
                 .write_all(&frame[..n])
                 .and_then(|()| self.port.flush())
                 .map_err(|e| Error::Line(LineError::Io(e)))?;
-            let deadline = Instant::now() + self.timeout;
+            let deadline = (Instant::now() + self.timeout).min(window);
             while Instant::now() < deadline {
                 match self.poll(self.seq)? {
                     Heard::Nothing => continue,
@@ -293,6 +301,9 @@ impl<P: Read + Write> Client<P> {
                     Heard::Answer(Response::Refused(r)) => return Err(Error::Refused(r)),
                     Heard::Answer(resp) => return Ok(resp),
                 }
+                break;
+            }
+            if Instant::now() >= window {
                 break;
             }
         }

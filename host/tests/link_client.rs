@@ -267,10 +267,11 @@ fn answers_lost_every_time_fail_the_line_within_the_window() {
     assert_eq!(c.window(), Duration::from_millis(40));
     let t = std::time::Instant::now();
     assert!(matches!(c.stop(), Err(Error::Line(LineError::Timeout))));
-    // Four tries of 10 ms: at least 40 ms (a bound below; above, only the machine's load).
+    // The window, 4 tries of 10 ms, is waited out (a bound below; above, only the machine's
+    // load), and nothing comes back to ask again at once for: one copy a try at most.
     assert!(t.elapsed() >= Duration::from_millis(40));
     let rig = c.into_inner();
-    assert_eq!(rig.frames_in, 4);
+    assert!((1..=4).contains(&rig.frames_in), "{}", rig.frames_in);
     // The stop was carried out once, whatever the host could tell.
     assert_eq!(rig.rig.rig().server().counters.commands, 1);
 }
