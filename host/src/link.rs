@@ -363,6 +363,8 @@ impl<P: Read + Write> Client<P> {
 }
 
 /// What one read brought, the most telling first: the answer, else a damaged frame.
+// Lives for one read, on the stack.
+#[allow(clippy::large_enum_variant)]
 enum Heard {
     Nothing,
     Damaged,
