@@ -10,10 +10,10 @@
 //! **Retries, exactly once.** A call sends its request and waits for the answer with the
 //! request's seq. Without one within the per-try timeout the same frame — the same seq — is
 //! sent again; so it is at once when the rig says it could not read the frame, or a damaged
-//! frame arrives (it may have been the answer), without waiting the try out. The rig answers a repeat from the answer it already gave without
-//! carrying it out again (`kapitza_core::station::repeat`), so a command whose answer was lost
-//! is carried out once and still answered; an answer to any copy is taken. A refusal is never
-//! retried. The version handshake ([`Client::version`]) is a call like any other, so opening
+//! frame arrives (it may have been the answer), without waiting the try out. The rig answers a
+//! repeat from the answer it already gave without carrying it out again
+//! (`kapitza_core::station::repeat`), so a command whose answer was lost is carried out once
+//! and still answered; an answer to any copy is taken. A refusal is never retried. The version handshake ([`Client::version`]) is a call like any other, so opening
 //! and reopening a line retry the same way.
 //!
 //! | | default |
@@ -25,7 +25,7 @@
 //!
 //! On the line the tests damage (3 bytes in 400), a 170-byte configuration answer arrives
 //! whole about one time in four; a round trip over a pseudo-terminal takes a few ms, so the
-//! window holds dozens of tries and a call fails only when the machine stalls it.
+//! window holds dozens of tries.
 //!
 //! The port's `read` should return within a few milliseconds when no byte arrives (a serial
 //! port's read timeout, `Ok(0)`, `TimedOut` or `WouldBlock`).
