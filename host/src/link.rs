@@ -5,13 +5,30 @@
 //! Errors keep two things apart ([`Error`]): **the line failed** ([`Error::Line`]: no answer,
 //! an I/O error, frames damaged on every try, a rig that speaks another protocol version) and
 //! **the rig refused** ([`Error::Refused`]: it understood the command and said no, with a
-//! [`Reason`]; nothing changed). A call is retried on a link-level failure (a damaged frame
-//! either way, a timeout), never on a refusal; every command is a setting (R and θd, stop,
-//! clear, a configuration), so a retried one that had arrived the first time does no harm.
+//! [`Reason`]; nothing changed).
+//!
+//! **Retries, exactly once.** A call sends its request and waits for the answer with the
+//! request's seq. Without one within the per-try timeout the same frame — the same seq — is
+//! sent again; so it is at once when the rig says it could not read the frame, or a damaged
+//! frame arrives (it may have been the answer), without waiting the try out. The rig answers a
+//! repeat from the answer it already gave without carrying it out again
+//! (`kapitza_core::station::repeat`), so a command whose answer was lost is carried out once
+//! and still answered; an answer to any copy is taken. A refusal is never retried. The version handshake ([`Client::version`]) is a call like any other, so opening
+//! and reopening a line retry the same way.
+//!
+//! | | default |
+//! |---|---|
+//! | per-try timeout | [`ANSWER_TIMEOUT`] = 40 ms (a round trip of the largest frames at 115200 baud, behind the telemetry queued before it, is about 55 ms: an answer later than the try is still taken) |
+//! | tries | [`TRIES`] = 25 |
+//! | retry window | tries × per-try timeout = 1 s, then the line has failed ([`LineError::Timeout`] or the last link-level reason) |
+//! | copies sent | at most [`MAX_SENDS_PER_TRY`] × tries = 100 in the window (damaged answers asked again at once) |
+//!
+//! On the line the tests damage (3 bytes in 400), a 170-byte configuration answer arrives
+//! whole about one time in four; a round trip over a pseudo-terminal takes a few ms, so the
+//! window holds dozens of tries.
 //!
 //! The port's `read` should return within a few milliseconds when no byte arrives (a serial
-//! port's read timeout, `Ok(0)`, `TimedOut` or `WouldBlock`); the call's own deadline is
-//! [`Client::with_timeout`].
+//! port's read timeout, `Ok(0)`, `TimedOut` or `WouldBlock`).
 
 use std::collections::VecDeque;
 use std::fmt;
@@ -68,6 +85,14 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// How long one try waits for its answer before the request is sent again.
+pub const ANSWER_TIMEOUT: Duration = Duration::from_millis(40);
+/// How many per-try timeouts make the retry window.
+pub const TRIES: u32 = 25;
+/// A damaged answer is asked for again at once, without waiting its try out: at most this many
+/// copies per try in the window, a bound on what a call sends.
+pub const MAX_SENDS_PER_TRY: u32 = 4;
+
 /// A connection to a rig.
 pub struct Client<P> {
     port: P,
@@ -89,27 +114,34 @@ fn q16(x: f64, what: &'static str) -> Result<i32, Error> {
 }
 
 impl<P: Read + Write> Client<P> {
-    /// A client with a 500 ms answer timeout and 3 tries per call.
+    /// A client with the default retries: [`TRIES`] tries of [`ANSWER_TIMEOUT`] each.
     pub fn new(port: P) -> Self {
         Self {
             port,
             seq: 0,
             reader: FrameReader::new(),
-            timeout: Duration::from_millis(500),
-            tries: 3,
+            timeout: ANSWER_TIMEOUT,
+            tries: TRIES,
             telemetry: VecDeque::new(),
             raw: VecDeque::new(),
         }
     }
 
+    /// The per-try timeout.
     pub fn with_timeout(mut self, timeout: Duration) -> Self {
         self.timeout = timeout;
         self
     }
 
+    /// How many times a request is sent (at least once).
     pub fn with_tries(mut self, tries: u32) -> Self {
         self.tries = tries.max(1);
         self
+    }
+
+    /// The longest a call waits before it reports the line as failed: tries × per-try timeout.
+    pub fn window(&self) -> Duration {
+        self.timeout * self.tries
     }
 
     pub fn into_inner(self) -> P {
@@ -169,9 +201,9 @@ impl<P: Read + Write> Client<P> {
         self.ok(Request::Telemetry { period_ms })
     }
 
-    /// The next telemetry snapshot, waiting up to the timeout for one.
+    /// The next telemetry snapshot, waiting up to the retry window for one.
     pub fn telemetry(&mut self) -> Result<Telemetry, Error> {
-        let deadline = Instant::now() + self.timeout;
+        let deadline = Instant::now() + self.window();
         loop {
             if let Some(t) = self.telemetry.pop_front() {
                 return Ok(t);
@@ -201,9 +233,9 @@ impl<P: Read + Write> Client<P> {
         self.ok(req)
     }
 
-    /// The next raw snapshot of bring-up mode, waiting up to the timeout for one.
+    /// The next raw snapshot of bring-up mode, waiting up to the retry window for one.
     pub fn raw_telemetry(&mut self) -> Result<RawTelemetry, Error> {
-        let deadline = Instant::now() + self.timeout;
+        let deadline = Instant::now() + self.window();
         loop {
             if let Some(t) = self.raw.pop_front() {
                 return Ok(t);
@@ -236,42 +268,52 @@ impl<P: Read + Write> Client<P> {
         }
     }
 
-    /// Sends `req` and waits for its answer, retrying on link-level failures.
+    /// Sends `req` and waits for its answer, sending the same frame again (the same seq) after
+    /// a per-try timeout without it, and at once on a link-level refusal or a damaged frame,
+    /// until the retry window (tries × per-try timeout) is over or [`MAX_SENDS_PER_TRY`] × tries
+    /// copies are out.
     fn call(&mut self, req: Request) -> Result<Response, Error> {
+        // seq 0 is what the rig answers a frame it could not read with; never ours.
+        self.seq = self.seq.wrapping_add(1).max(1);
+        let mut frame = [0u8; MAX_REQUEST_FRAME];
+        let n = encode(Header::new(self.seq), &req, &mut frame)
+            .map_err(|_| Error::Invalid("request larger than a frame"))?;
         let mut last = LineError::Timeout;
-        for _ in 0..self.tries {
-            // seq 0 is what the rig answers a frame it could not read with; never ours.
-            self.seq = self.seq.wrapping_add(1).max(1);
-            let mut frame = [0u8; MAX_REQUEST_FRAME];
-            let n = encode(Header::new(self.seq), &req, &mut frame)
-                .map_err(|_| Error::Invalid("request larger than a frame"))?;
+        let window = Instant::now() + self.window();
+        for _ in 0..self.tries.saturating_mul(MAX_SENDS_PER_TRY) {
             self.port
                 .write_all(&frame[..n])
                 .and_then(|()| self.port.flush())
                 .map_err(|e| Error::Line(LineError::Io(e)))?;
-            let deadline = Instant::now() + self.timeout;
-            last = LineError::Timeout;
+            let deadline = (Instant::now() + self.timeout).min(window);
             while Instant::now() < deadline {
                 match self.poll(self.seq)? {
-                    None => {}
-                    Some(Response::Refused(r)) if r.is_link() => {
+                    Heard::Nothing => continue,
+                    Heard::Damaged => {
+                        last = LineError::Link(Reason::BadCrc);
+                    }
+                    Heard::Answer(Response::Refused(r)) if r.is_link() => {
                         if let Reason::VersionMismatch { .. } = r {
                             return Err(Error::Line(LineError::VersionMismatch(r)));
                         }
                         last = LineError::Link(r);
-                        break;
                     }
-                    Some(Response::Refused(r)) => return Err(Error::Refused(r)),
-                    Some(resp) => return Ok(resp),
+                    Heard::Answer(Response::Refused(r)) => return Err(Error::Refused(r)),
+                    Heard::Answer(resp) => return Ok(resp),
                 }
+                break;
+            }
+            if Instant::now() >= window {
+                break;
             }
         }
         Err(Error::Line(last))
     }
 
     /// Reads what has arrived. Returns the answer to `seq` (or a link-level refusal of a frame
-    /// the rig could not read, seq 0), queues telemetry, drops everything else.
-    fn poll(&mut self, seq: u8) -> Result<Option<Response>, Error> {
+    /// the rig could not read, seq 0), else whether a damaged frame came; queues telemetry and
+    /// drops everything else.
+    fn poll(&mut self, seq: u8) -> Result<Heard, Error> {
         let mut buf = [0u8; 512];
         let n = match self.port.read(&mut buf) {
             Ok(n) => n,
@@ -290,25 +332,53 @@ impl<P: Read + Write> Client<P> {
         if n == 0 {
             std::thread::sleep(Duration::from_millis(1));
         }
-        let mut answer = None;
+        let mut heard = Heard::Nothing;
         for &b in &buf[..n] {
-            let Some(Ok(stuffed)) = self.reader.push(b) else {
-                continue;
+            let stuffed = match self.reader.push(b) {
+                None => continue,
+                Some(Ok(stuffed)) => stuffed,
+                Some(Err(_)) => {
+                    heard = heard.or(Heard::Damaged);
+                    continue;
+                }
             };
             match receive_response(stuffed) {
                 Ok((_, Response::Telemetry(t))) => self.telemetry.push_back(t),
                 Ok((_, Response::Raw(t))) => self.raw.push_back(t),
-                Ok((h, resp)) if h.seq == seq && seq != 0 => answer = Some(resp),
+                Ok((h, resp)) if h.seq == seq && seq != 0 => heard = Heard::Answer(resp),
                 Ok((h, Response::Refused(r))) if h.seq == 0 && r.is_link() && seq != 0 => {
-                    answer = Some(Response::Refused(r))
+                    heard = heard.or(Heard::Answer(Response::Refused(r)))
                 }
                 Err(r @ Reason::VersionMismatch { .. }) => {
                     return Err(Error::Line(LineError::VersionMismatch(r)))
                 }
-                // A stale answer, or one damaged on the way back: the deadline decides.
-                _ => {}
+                // Damaged on the way back: perhaps the answer.
+                Err(_) => heard = heard.or(Heard::Damaged),
+                // A stale answer (to an earlier call, or a second copy's).
+                Ok(_) => {}
             }
         }
-        Ok(answer)
+        Ok(heard)
+    }
+}
+
+/// What one read brought, the most telling first: the answer, else a damaged frame.
+// Lives for one read, on the stack.
+#[allow(clippy::large_enum_variant)]
+enum Heard {
+    Nothing,
+    Damaged,
+    Answer(Response),
+}
+
+impl Heard {
+    /// `self`, unless `other` tells more.
+    fn or(self, other: Heard) -> Heard {
+        match (&self, &other) {
+            (Heard::Answer(Response::Refused(r)), Heard::Answer(_)) if r.is_link() => other,
+            (Heard::Answer(_), _) => self,
+            (_, Heard::Nothing) => self,
+            _ => other,
+        }
     }
 }

@@ -18,12 +18,16 @@ use kapitza_core::simrig::{Params, SimRig};
 const CFG: RigConfig = RigConfig::REFERENCE;
 
 /// The simulated rig on the other end of an in-memory line. `damage(n)` decides whether the
-/// n-th frame from the host arrives with a byte flipped. Every read lets 1 ms of rig time pass.
+/// n-th frame from the host arrives with a byte flipped, `lose(n)` whether the n-th frame from
+/// the rig is lost on the way back. Every read lets 1 ms of rig time pass.
 struct Line {
     rig: SimRig,
     partial: Vec<u8>,
     frames_in: u32,
     damage: fn(u32) -> bool,
+    out_partial: Vec<u8>,
+    frames_out: u32,
+    lose: fn(u32) -> bool,
 }
 
 impl Line {
@@ -42,6 +46,9 @@ impl Line {
             partial: Vec::new(),
             frames_in: 0,
             damage: |_| false,
+            out_partial: Vec::new(),
+            frames_out: 0,
+            lose: |_| false,
         }
     }
 }
@@ -70,7 +77,21 @@ impl Write for Line {
 impl Read for Line {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         self.rig.run(1e-3);
-        match self.rig.transmit(buf) {
+        let mut sent = vec![0u8; buf.len()];
+        let n = self.rig.transmit(&mut sent);
+        let mut kept = 0;
+        for &b in &sent[..n] {
+            self.out_partial.push(b);
+            if b == 0 {
+                self.frames_out += 1;
+                let frame = std::mem::take(&mut self.out_partial);
+                if !(self.lose)(self.frames_out) {
+                    buf[kept..kept + frame.len()].copy_from_slice(&frame);
+                    kept += frame.len();
+                }
+            }
+        }
+        match kept {
             0 => Err(io::ErrorKind::TimedOut.into()),
             n => Ok(n),
         }
@@ -197,6 +218,62 @@ fn a_noisy_line_is_retried_and_never_misapplied() {
         c.into_inner().rig.rig().server().rig.supervisor().mode(),
         safety::Mode::Idle
     );
+}
+
+/// A client whose tries are short: the in-memory rig answers at the first read after a
+/// request, so only a lost answer waits a try out.
+fn quick(rig: Line) -> Client<Line> {
+    Client::new(rig).with_timeout(Duration::from_millis(50))
+}
+
+#[test]
+fn a_lost_answer_is_asked_again_and_the_command_carried_out_once() {
+    let mut rig = Line::new();
+    rig.lose = |n| n == 1;
+    let mut c = quick(rig);
+    // The start is carried out at its first copy (its pre-run check begins); the second copy,
+    // under the same seq, is answered from that answer. Carried out again it would be refused:
+    // a check is running.
+    c.set_drive(2.0, 45.0).unwrap();
+    let rig = c.into_inner();
+    assert!(rig.frames_in >= 2, "sent {} times", rig.frames_in);
+    let srv = rig.rig.rig().server();
+    assert_eq!(srv.counters.commands, 1);
+    assert_eq!(srv.check, Some(kapitza_core::link::message::Check::Running));
+    // The next command is a new one (the next seq), carried out: a stop aborts the check.
+    let mut c = quick(rig);
+    c.stop().unwrap();
+    assert_eq!(c.status().unwrap().mode, Mode::Idle);
+    assert_eq!(c.into_inner().rig.rig().server().counters.commands, 2);
+}
+
+#[test]
+fn the_handshake_survives_a_lost_answer() {
+    let mut rig = Line::new();
+    rig.lose = |n| n == 1;
+    let mut c = quick(rig);
+    let v = c.version().unwrap();
+    assert_eq!((v.protocol, v.firmware), (PROTOCOL_VERSION, [0, 1, 0]));
+    assert!(c.into_inner().frames_in >= 2);
+}
+
+#[test]
+fn answers_lost_every_time_fail_the_line_within_the_window() {
+    let mut rig = Line::new();
+    rig.lose = |_| true;
+    let mut c = Client::new(rig)
+        .with_timeout(Duration::from_millis(10))
+        .with_tries(4);
+    assert_eq!(c.window(), Duration::from_millis(40));
+    let t = std::time::Instant::now();
+    assert!(matches!(c.stop(), Err(Error::Line(LineError::Timeout))));
+    // The window, 4 tries of 10 ms, is waited out (a bound below; above, only the machine's
+    // load), and nothing comes back to ask again at once for: one copy a try at most.
+    assert!(t.elapsed() >= Duration::from_millis(40));
+    let rig = c.into_inner();
+    assert!((1..=4).contains(&rig.frames_in), "{}", rig.frames_in);
+    // The stop was carried out once, whatever the host could tell.
+    assert_eq!(rig.rig.rig().server().counters.commands, 1);
 }
 
 /// A line that swallows everything.

@@ -304,14 +304,16 @@ impl Drop for NoisyLine {
     }
 }
 
-/// The settings a `--truth` log says the rig applied: (R requested, θd target).
-fn applied(truth: &std::path::Path) -> Vec<(f64, f64)> {
+/// One setting a `--truth` log says the rig applied: the rig's command count after it, R
+/// requested, θd target.
+fn applied(truth: &std::path::Path) -> Vec<(u64, f64, f64)> {
     std::fs::read_to_string(truth)
         .unwrap()
         .lines()
         .map(|l| {
             let v: Value = serde_json::from_str(l).unwrap();
             (
+                v["commands"].as_u64().unwrap(),
                 v["r_target"].as_f64().unwrap(),
                 v["drive_angle_target_deg"].as_f64().unwrap(),
             )
@@ -319,18 +321,63 @@ fn applied(truth: &std::path::Path) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Sends `commands` through a noisy line with `kapitza set`; returns (sent, carried out,
-/// refused, failed clearly, wrong) against the rig's truth log.
-fn noisy_run(commands: usize, seed: u64, one_in: u64) -> [usize; 5] {
+/// What a run of `kapitza set` through a noisy line came to, against the rig's truth log.
+#[derive(Debug, Default)]
+struct Tally {
+    sent: usize,
+    /// Exit 0, or 4 (the wait timed out: the command was carried out).
+    carried_out: usize,
+    /// Exit 1 with the refusal the command asked for (R = 9 is above ω_max).
+    refused: usize,
+    /// Exit 1 for another reason.
+    refused_otherwise: usize,
+    /// Any other exit (3: the line failed, said so).
+    failed: usize,
+    /// A setting the rig applied that no command asked for, or a command reported carried out
+    /// that the rig did not apply.
+    wrong: usize,
+    /// Commands the rig carried out more than once.
+    twice: usize,
+    minutes: f64,
+}
+
+impl std::fmt::Display for Tally {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "sent {}: carried out {}, refused for their own reason {}, refused otherwise {}, \
+             failed clearly {}, wrong {}, carried out twice {}; {:.1} min",
+            self.sent,
+            self.carried_out,
+            self.refused,
+            self.refused_otherwise,
+            self.failed,
+            self.wrong,
+            self.twice,
+            self.minutes
+        )
+    }
+}
+
+/// Sends `commands` through a noisy line with `kapitza set` and checks what the rig says it
+/// applied (its `--truth` log: one line, with the rig's command count, whenever the count moves).
+fn noisy_run(commands: usize, seed: u64, one_in: u64) -> Tally {
+    let started = Instant::now();
     let dir = tempfile::tempdir().unwrap();
     let truth = dir.path().join("truth.jsonl");
     let rig = serve(&["--truth", truth.to_str().unwrap()]);
     let line = NoisyLine::new(&rig.first_line, seed, one_in);
     let mut sent = Vec::new();
-    let (mut ok, mut refused, mut failed) = (0, 0, 0);
+    let mut claimed = Vec::new();
+    let mut t = Tally {
+        sent: commands,
+        ..Tally::default()
+    };
+    let mut checks_failed = 0;
     for i in 0..commands {
         // Every fifth asks for more than the rig allows (R = 9 is above ω_max).
-        let r = if i % 5 == 4 {
+        let too_much = i % 5 == 4;
+        let r = if too_much {
             9.0
         } else {
             0.5 + (i % 7) as f64 * 0.25
@@ -349,42 +396,73 @@ fn noisy_run(commands: usize, seed: u64, one_in: u64) -> [usize; 5] {
             "0.001",
         ]);
         sent.push((r, angle));
+        let e = String::from_utf8_lossy(&o.stderr);
         match o.status.code() {
             // Taken (the wait itself times out at once: exit 4 means it was carried out).
-            Some(0) | Some(4) => ok += 1,
-            Some(1) => refused += 1,
-            _ => failed += 1,
+            Some(0) | Some(4) if !too_much => {
+                t.carried_out += 1;
+                claimed.push(i);
+            }
+            Some(1) if too_much && e.contains("above the limit") => t.refused += 1,
+            Some(0) | Some(4) => t.wrong += 1,
+            Some(1) => {
+                eprintln!("command {i} (R = {r}, θd = {angle}) refused otherwise: {e}");
+                checks_failed += usize::from(e.contains("pre-run check failed"));
+                t.refused_otherwise += 1
+            }
+            _ => {
+                eprintln!("command {i} (R = {r}, θd = {angle}) failed: {e}");
+                t.failed += 1
+            }
         }
     }
     drop(line);
     std::thread::sleep(Duration::from_millis(100));
     drop(rig);
-    // Wrong: a setting the rig applied that no command asked for (R to 0.5 %, θd to 0.01°).
-    let wrong = applied(&truth)
-        .iter()
-        .filter(|(r, a)| {
-            !sent
-                .iter()
-                .any(|(sr, sa)| (r / sr - 1.0).abs() < 5e-3 && (a - sa).abs() < 1e-2)
-        })
-        .count();
-    [commands, ok, refused, failed, wrong]
+    // Each command carries out at most one setting, and two in a row never ask for the same
+    // one (θd differs), so the truth log's entries belong to increasing command numbers: an
+    // entry for the same command as the one before is that command carried out again, and so
+    // is a count that moved by more than one per entry (a start whose pre-run check failed
+    // moves it without an entry, and says so).
+    let matches = |k: usize, r: f64, a: f64| {
+        let (sr, sa) = sent[k];
+        (r / sr - 1.0).abs() < 5e-3 && (a - sa).abs() < 1e-2
+    };
+    let (mut count, mut last, mut extra) = (0u64, None::<usize>, 0usize);
+    let mut done = Vec::new();
+    for (c, r, a) in applied(&truth) {
+        extra += (c - count).saturating_sub(1) as usize;
+        count = c;
+        match last {
+            Some(k) if matches(k, r, a) => t.twice += 1,
+            _ => match (last.map_or(0, |k| k + 1)..sent.len()).find(|&k| matches(k, r, a)) {
+                Some(k) => {
+                    last = Some(k);
+                    done.push(k);
+                }
+                None => t.wrong += 1,
+            },
+        }
+    }
+    t.twice += extra.saturating_sub(checks_failed);
+    // Reported carried out, yet not applied.
+    t.wrong += claimed.iter().filter(|k| !done.contains(k)).count();
+    t.minutes = started.elapsed().as_secs_f64() / 60.0;
+    t
 }
 
 #[test]
 fn a_corrupting_line_never_gives_a_wrong_setting() {
-    let [sent, ok, refused, failed, wrong] = noisy_run(20, 7, 1000);
-    eprintln!(
-        "sent {sent}: carried out {ok}, refused {refused}, failed clearly {failed}, wrong {wrong}"
+    let t = noisy_run(20, 7, 1000);
+    eprintln!("{t}");
+    assert_eq!((t.wrong, t.twice), (0, 0), "{t}");
+    assert_eq!(
+        t.carried_out + t.refused + t.refused_otherwise + t.failed,
+        t.sent
     );
-    assert_eq!(wrong, 0);
-    assert_eq!(ok + refused + failed, sent);
-    // One byte in 330 damaged: a 170-byte configuration frame arrives intact 60 % of the time,
-    // so retries carry most commands through; the few that fail say so (exit 3).
-    assert!(
-        ok + refused >= sent / 2,
-        "only {ok} + {refused} of {sent} answered"
-    );
+    // Three bytes in 1000 damaged: a 170-byte configuration answer arrives whole 60 % of the
+    // time, and 25 tries fail a call with probability 0.4^25; all 20 get through.
+    assert_eq!(t.carried_out + t.refused, t.sent, "{t}");
 }
 
 /// Thousands of commands through the noisy line (minutes): `cargo test -p kapitza --test
@@ -392,9 +470,11 @@ fn a_corrupting_line_never_gives_a_wrong_setting() {
 #[test]
 #[ignore]
 fn soak_noisy_line() {
-    let [sent, ok, refused, failed, wrong] = noisy_run(2000, 11, 400);
-    println!("soak: sent {sent}, carried out {ok}, refused {refused}, failed clearly {failed}, wrong {wrong}");
-    assert_eq!(wrong, 0);
+    let t = noisy_run(2000, 11, 400);
+    println!("soak: {t}");
+    assert_eq!((t.wrong, t.twice), (0, 0), "{t}");
+    // Issue 23: at least 99 % carried out or refused for their own reason.
+    assert!((t.carried_out + t.refused) * 100 >= t.sent * 99, "{t}");
 }
 
 #[test]

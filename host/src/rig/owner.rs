@@ -104,6 +104,9 @@ pub struct Owner {
     clients: Receiver<(usize, UnixStream)>,
     client_tx: Sender<(usize, UnixStream)>,
     writers: Vec<(usize, UnixStream, bool)>,
+    /// Each socket client's last command and its answer: a client resends what it got no
+    /// answer to under the same seq, and gets the answer without the rig carrying it out twice.
+    answered: Vec<(usize, u8, Request, Response)>,
     next_alive: Instant,
     next_reopen: Instant,
 }
@@ -128,6 +131,7 @@ impl Owner {
             clients,
             client_tx,
             writers: Vec::new(),
+            answered: Vec::new(),
             next_alive: Instant::now(),
             next_reopen: Instant::now(),
         };
@@ -264,18 +268,34 @@ impl Owner {
                 }
                 Some(Response::Ok)
             }
-            req => {
-                events.push(Event::Relayed(Box::new(req)));
-                match self.session.as_mut().map(|s| s.client.request(req)) {
-                    Some(Ok(r)) => Some(r),
-                    Some(Err(Error::Refused(r))) => Some(Response::Refused(r)),
-                    Some(Err(e)) => {
-                        self.lost(e, events);
-                        None
+            req => match self
+                .answered
+                .iter()
+                .find(|a| (a.0, a.1, &a.2) == (job.client, job.seq, &req))
+            {
+                Some(a) => Some(a.3),
+                None => {
+                    events.push(Event::Relayed(Box::new(req)));
+                    let answer = match self.session.as_mut().map(|s| s.client.request(req)) {
+                        Some(Ok(r)) => Some(r),
+                        Some(Err(Error::Refused(r))) => Some(Response::Refused(r)),
+                        Some(Err(e)) => {
+                            self.lost(e, events);
+                            None
+                        }
+                        None => None,
+                    };
+                    self.answered.retain(|a| a.0 != job.client);
+                    let query = matches!(
+                        req,
+                        Request::GetVersion | Request::GetStatus | Request::GetConfig
+                    );
+                    if let (Some(r), false) = (answer, query) {
+                        self.answered.push((job.client, job.seq, req, r));
                     }
-                    None => None,
+                    answer
                 }
-            }
+            },
         };
         if let Some(resp) = answer {
             let mut frame = [0u8; MAX_RESPONSE_FRAME];
@@ -284,6 +304,8 @@ impl Owner {
                     .retain_mut(|w| w.0 != job.client || still_there(w.1.write_all(&frame[..n])));
             }
         }
+        let writers = &self.writers;
+        self.answered.retain(|a| writers.iter().any(|w| w.0 == a.0));
     }
 
     fn fan_out(&mut self, resp: &Response) {

@@ -21,8 +21,12 @@ use super::simhost::{SimOptions, SimPort};
 use super::{Exit, Failure};
 use crate::link::{Client, Error, LineError};
 
-/// How long a rig has to answer one request before it is sent again.
-const ANSWER_TIMEOUT: Duration = Duration::from_millis(300);
+/// Through an owner, how long one try waits: the owner's own retry window on the line behind
+/// it, and some. The owner answers a resent request from its first answer, so a resend through
+/// it is carried out once too.
+const OWNER_TIMEOUT: Duration = Duration::from_millis(1500);
+/// Through an owner, how many tries (the socket itself loses nothing).
+const OWNER_TRIES: u32 = 2;
 
 /// A checked connection.
 pub struct Session {
@@ -61,7 +65,10 @@ pub fn open(target: &Target, sim: &SimOptions) -> Result<Session> {
 
 /// The version exchange and the configuration, on a freshly opened port.
 pub fn check(port: Box<dyn ReadWrite>, name: String, via_owner: bool) -> Result<Session> {
-    let mut client = Client::new(port).with_timeout(ANSWER_TIMEOUT);
+    let mut client = Client::new(port);
+    if via_owner {
+        client = client.with_timeout(OWNER_TIMEOUT).with_tries(OWNER_TRIES);
+    }
     let version = client.version().map_err(|e| line_failure(&name, e))?;
     check_version(&version, &name)?;
     let config = client.config().map_err(|e| line_failure(&name, e))?;

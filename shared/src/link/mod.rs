@@ -26,10 +26,27 @@
 //! ```
 //! Noise, a lost byte or a truncated frame fails the CRC or the strict decode, and is answered
 //! with a link-level reason; it can never be taken for another valid request (a wrong frame
-//! passes CRC-32C with probability 2^-32). A refused command changes nothing on the rig. The
-//! rig acts on every valid request once: the host resends only after a link-level refusal or a
-//! timeout, and the commands are idempotent settings (R and θd, stop, clear), so a duplicate
-//! does no harm.
+//! passes CRC-32C with probability 2^-32). A refused command changes nothing on the rig.
+//!
+//! # Exactly once over a damaged line
+//!
+//! A request whose answer does not arrive in time, or arrives damaged, is sent again **with the
+//! same seq**; the rig answers a repeat of the last request it answered (same seq, same bytes)
+//! with the answer it already gave and does not carry it out again
+//! ([`crate::station::repeat`]). So a command whose answer was lost is carried out once and its
+//! answer still arrives; a late answer to an earlier copy is as good as the last one's.
+//!
+//! ```text
+//! laptop                                  rig
+//! SetDrive, seq 7  ───────────────────▶   carried out; answer Ok, seq 7 (lost on the way)
+//!   no answer within the per-try timeout
+//! SetDrive, seq 7  ───────────────────▶   a repeat: Ok, seq 7 again, nothing carried out
+//!                  ◀───────────────────   Ok, seq 7
+//! ```
+//! The host's retry window is bounded (tries × per-try timeout; the host tool's `link` module
+//! gives the numbers) and then reports the line as failed. Each new request takes the next seq
+//! (1…255, 0 is the rig's answer to a frame it could not read), so two different requests in a
+//! row never share one.
 //!
 //! One request, there and back:
 //!

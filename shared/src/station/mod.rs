@@ -24,6 +24,10 @@
 //! caller calls `receive` from the same context as `control` (the firmware: at the control
 //! tick, with the bytes its UART task collected), which keeps the rig single-owner.
 //!
+//! **A repeat is answered, not carried out again** ([`repeat`]): the host resends a request
+//! whose answer it did not get under the same sequence number, and the same seq and bytes as
+//! the last request are answered with the answer already given.
+//!
 //! **The output never blocks the loop.** Frames wait in a fixed outbox until the caller's line
 //! takes them. Telemetry is queued only while room for one answer is left behind it; a frame
 //! that does not fit is dropped and counted (`Counters::frames_dropped`).
@@ -44,6 +48,7 @@
 
 pub mod drive;
 pub mod precheck;
+pub mod repeat;
 pub mod serve;
 
 use crate::link::convert::to_q16;
@@ -61,6 +66,7 @@ use crate::rig::safety::Mode;
 use crate::rig::servo::ServoMap;
 use drive::{Calibrated, Drive};
 use precheck::{SensorView, Step};
+use repeat::FrameId;
 use serve::{apply, Activity, Clock, Effect, RigServer};
 
 /// The shortest telemetry period (ms): a telemetry frame is ≤ 100 bytes, 8.7 ms at 115200 baud.
@@ -393,16 +399,20 @@ impl RigLoop {
             };
             let (seq, req) = match got {
                 Ok(stuffed) => match open(stuffed) {
-                    Ok(f) => (f.header.seq, decode_request_as(&f, self.srv.protocol)),
+                    Ok(f) => (
+                        f.header.seq,
+                        decode_request_as(&f, self.srv.protocol)
+                            .map(|req| (FrameId::of(f.header.seq, f.payload), req)),
+                    ),
                     Err(r) => (0, Err(r)),
                 },
                 Err(r) => (0, Err(r)),
             };
             let c = &mut self.srv.counters;
             let resp = match req {
-                Ok(req) => {
+                Ok((id, req)) => {
                     c.frames_ok = c.frames_ok.saturating_add(1);
-                    self.answer(req, link_us)
+                    self.answer(id, req, link_us)
                 }
                 Err(reason) => {
                     c.frames_bad = c.frames_bad.saturating_add(1);
@@ -455,13 +465,13 @@ impl RigLoop {
         self.srv.cfg.sample_hz
     }
 
-    fn answer(&mut self, req: Request, link_us: u32) -> Response {
+    fn answer(&mut self, id: FrameId, req: Request, link_us: u32) -> Response {
         let at = Clock {
             rig_us: self.last.t_us,
             link_us,
             uptime_ms: (self.uptime_us / 1000) as u32,
         };
-        let (resp, effect) = self.srv.respond(req, at, self.estop);
+        let (resp, effect) = self.srv.respond_once(id, req, at, self.estop);
         match effect {
             Effect::None => {}
             Effect::StoreConfig(cfg) => {

@@ -3,6 +3,7 @@
 //! request. [`crate::station::RigLoop`] owns one and frames its answers.
 
 use super::precheck::PreCheck;
+use super::repeat::{FrameId, LastAnswer};
 use crate::link::convert::{deg_along_travel, from_q16, to_q16};
 use crate::link::message::Verdict;
 use crate::link::message::{
@@ -201,6 +202,8 @@ pub struct RigServer {
     pub protocol: u8,
     /// Why the rig last reset (reported in the status).
     pub reset: ResetInfo,
+    /// The last request answered, to answer its repeat from it ([`super::repeat`]).
+    pub last: Option<LastAnswer>,
 }
 
 impl RigServer {
@@ -225,7 +228,28 @@ impl RigServer {
             firmware,
             protocol: crate::link::PROTOCOL_VERSION,
             reset: ResetInfo::POWER_ON,
+            last: None,
         }
+    }
+
+    /// Answers the request that arrived as frame `id`: a repeat of the last one (the host
+    /// resending what it got no answer to) from the answer already given, without carrying it
+    /// out again; any other as [`RigServer::respond`] does.
+    pub fn respond_once(
+        &mut self,
+        id: FrameId,
+        req: Request,
+        at: Clock,
+        estop: bool,
+    ) -> (Response, Effect) {
+        if let Some(resp) = self.last.and_then(|l| l.recall(id)) {
+            self.rig.link_message(at.link_us);
+            self.heard_us = at.link_us;
+            return (resp, Effect::None);
+        }
+        let (resp, effect) = self.respond(req, at, estop);
+        self.last = Some(LastAnswer::new(id, &req, &resp));
+        (resp, effect)
     }
 
     /// Answers one request (decoded from a valid frame, so it also counts as the link being
