@@ -134,7 +134,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let s = args.rig.connect()?;
     let name = s.name.clone();
     let served = match &target {
-        Target::Serial { path } if !s.via_owner => Some(Served::open(path, BUSY)?),
+        Target::Serial { path } if !s.via_owner => Served::open(path, BUSY)?,
         _ => None,
     };
     let (mut file, backup) = match &args.backup {

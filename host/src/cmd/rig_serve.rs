@@ -5,18 +5,18 @@
 //! also publishes it as a stable symlink, so a restarted rig is found at the same name. The pty's
 //! other end stays open here, so a client may come and go.
 
-use std::io::{self, BufWriter, Write};
-use std::os::fd::AsRawFd;
+use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
-use serialport::{SerialPort, TTYPort};
+use anyhow::Result;
 
 use super::rig_args::RigArgs;
 use crate::files;
-use crate::rig::simhost::{self, Line};
+use crate::rig::simhost;
 use crate::rig::{self as rigmod};
+
+mod pty;
 
 #[derive(Debug, clap::Subcommand)]
 pub enum Action {
@@ -66,55 +66,6 @@ pub struct ServeArgs {
     pub protocol: Option<u8>,
 }
 
-/// The pty's master end, never blocking.
-struct Pty(TTYPort);
-
-fn nonblocking(e: io::Error) -> io::Result<usize> {
-    match e.kind() {
-        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut | io::ErrorKind::Interrupted => Ok(0),
-        _ => Err(e),
-    }
-}
-
-impl Line for Pty {
-    fn take(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        io::Read::read(&mut self.0, buf).or_else(nonblocking)
-    }
-    fn give(&mut self, buf: &[u8]) -> io::Result<usize> {
-        io::Write::write(&mut self.0, buf).or_else(nonblocking)
-    }
-}
-
-fn set_nonblocking(port: &TTYPort) -> Result<()> {
-    let fd = port.as_raw_fd();
-    // SAFETY: fcntl on a descriptor this process owns, with flags it just read.
-    let ok = unsafe {
-        let flags = libc::fcntl(fd, libc::F_GETFL);
-        flags >= 0 && libc::fcntl(fd, libc::F_SETFL, flags | libc::O_NONBLOCK) == 0
-    };
-    if !ok {
-        bail!(
-            "cannot make the pseudo-terminal non-blocking: {}",
-            io::Error::last_os_error()
-        );
-    }
-    Ok(())
-}
-
-/// Points `link` at `target`, replacing a symlink (never a regular file) that is there.
-fn publish(link: &std::path::Path, target: &str) -> Result<()> {
-    if let Ok(meta) = std::fs::symlink_metadata(link) {
-        if !meta.file_type().is_symlink() {
-            bail!(
-                "--link {}: exists and is not a symlink; not replaced",
-                link.display()
-            );
-        }
-        std::fs::remove_file(link).with_context(|| format!("--link {}", link.display()))?;
-    }
-    std::os::unix::fs::symlink(target, link).with_context(|| format!("--link {}", link.display()))
-}
-
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let Action::Serve(a) = &args.action;
     let existing = files::Existing::from_flags(a.force, a.append);
@@ -132,6 +83,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
         .duration
         .map(|d| crate::input::positive("--duration", d))
         .transpose()?;
+    let (mut line, path) = pty::open()?;
     let mut truth = match &a.truth {
         Some(p) => Some(BufWriter::new(files::create_output(
             "--truth", p, existing,
@@ -140,12 +92,8 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     };
     // Before the link is published: a signal from then on still removes it.
     rigmod::catch_interrupt();
-    let (mut master, slave) = TTYPort::pair().context("cannot open a pseudo-terminal")?;
-    set_nonblocking(&master)?;
-    master.set_timeout(std::time::Duration::ZERO)?;
-    let path = slave.name().context("the pseudo-terminal has no name")?;
     if let Some(link) = &a.link {
-        publish(link, &path)?;
+        pty::publish(link, &path)?;
     }
     writeln!(out, "{path}")?;
     out.flush()?;
@@ -156,11 +104,11 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     let summary = simhost::run(
         opts.build(),
         opts.speed,
-        &mut Pty(master),
+        &mut line,
         &stop,
         truth.as_mut().map(|w| w as &mut dyn Write),
     );
-    drop(slave);
+    drop(line);
     if let Some(link) = &a.link {
         let _ = std::fs::remove_file(link);
     }

@@ -19,6 +19,7 @@
 //! confirm included), 4 `--wait` timed out, 5 superseded, 129 / 130 / 143 ended by SIGHUP /
 //! SIGINT / SIGTERM after the stop.
 
+pub mod control_socket;
 pub mod fields;
 pub mod file;
 pub mod live;

@@ -13,7 +13,6 @@
 //! ```
 
 use std::io::{Read, Write};
-use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::time::{Duration, Instant};
@@ -24,6 +23,7 @@ use kapitza_core::link::{
     FrameReader, Request, Response, Status, Telemetry, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME,
 };
 
+use super::control_socket::{self, Listener, Stream};
 use super::port::Target;
 use super::session::{self, Session};
 use super::simhost::SimOptions;
@@ -54,18 +54,13 @@ pub fn socket_path(port: &str) -> PathBuf {
 fn runtime_dir() -> PathBuf {
     match std::env::var_os("XDG_RUNTIME_DIR") {
         Some(d) if Path::new(&d).is_dir() => PathBuf::from(d).join("kapitza"),
-        _ => std::env::temp_dir().join(format!("kapitza-{}", uid())),
+        _ => std::env::temp_dir().join(format!("kapitza-{}", control_socket::uid())),
     }
 }
 
-fn uid() -> u32 {
-    // SAFETY: getuid has no preconditions and cannot fail.
-    unsafe { libc::getuid() }
-}
-
 /// A connection to the running owner of `port`, if there is one.
-pub fn connect(port: &str) -> Option<UnixStream> {
-    let s = UnixStream::connect(socket_path(port)).ok()?;
+pub fn connect(port: &str) -> Option<Stream> {
+    let s = control_socket::connect(&socket_path(port))?;
     s.set_read_timeout(Some(Duration::from_millis(5))).ok()?;
     Some(s)
 }
@@ -101,9 +96,9 @@ pub struct Owner {
     socket: Option<PathBuf>,
     jobs: Receiver<Job>,
     job_tx: Sender<Job>,
-    clients: Receiver<(usize, UnixStream)>,
-    client_tx: Sender<(usize, UnixStream)>,
-    writers: Vec<(usize, UnixStream, bool)>,
+    clients: Receiver<(usize, Stream)>,
+    client_tx: Sender<(usize, Stream)>,
+    writers: Vec<(usize, Stream, bool)>,
     /// Each socket client's last command and its answer: a client resends what it got no
     /// answer to under the same seq, and gets the answer without the rig carrying it out twice.
     answered: Vec<(usize, u8, Request, Response)>,
@@ -118,7 +113,7 @@ impl Owner {
         let (job_tx, jobs) = mpsc::channel();
         let (client_tx, clients) = mpsc::channel();
         let socket = match &target {
-            Target::Serial { path } => Some(listen(path, job_tx.clone(), client_tx.clone())?),
+            Target::Serial { path } => listen(path, job_tx.clone(), client_tx.clone())?,
             Target::Sim => None,
         };
         let mut o = Self {
@@ -169,8 +164,9 @@ impl Owner {
                 if let Ok(s) = session::open(&self.target, &self.sim) {
                     self.session = Some(s);
                     if let Target::Serial { path } = &self.target {
-                        self.socket =
-                            listen(path, self.job_tx.clone(), self.client_tx.clone()).ok();
+                        self.socket = listen(path, self.job_tx.clone(), self.client_tx.clone())
+                            .ok()
+                            .flatten();
                     }
                     if self.stream().is_ok() {
                         events.push(Event::LinkBack);
@@ -338,16 +334,20 @@ impl Drop for Owner {
 }
 
 /// Binds the control socket of `port` and accepts clients on a thread of its own; each
-/// client's frames are read on a thread and queued as jobs.
+/// client's frames are read on a thread and queued as jobs. None on a system without control
+/// sockets ([`control_socket::SUPPORTED`]).
 pub(super) fn listen(
     port: &str,
     jobs: Sender<Job>,
-    clients: Sender<(usize, UnixStream)>,
-) -> Result<PathBuf> {
+    clients: Sender<(usize, Stream)>,
+) -> Result<Option<PathBuf>> {
+    if !control_socket::SUPPORTED {
+        return Ok(None);
+    }
     let path = socket_path(port);
     let dir = path.parent().context("control socket path")?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    if UnixStream::connect(&path).is_ok() {
+    if Stream::connect(&path).is_ok() {
         anyhow::bail!(
             "{port} already has an owner (its control socket {} answers)",
             path.display()
@@ -356,7 +356,7 @@ pub(super) fn listen(
     let _ = std::fs::remove_file(&path);
     // A marker left by a command that died without its cleanup (`super::served`).
     let _ = std::fs::remove_file(path.with_extension("busy"));
-    let listener = UnixListener::bind(&path)
+    let listener = Listener::bind(&path)
         .with_context(|| format!("cannot open the control socket {}", path.display()))?;
     std::thread::spawn(move || {
         for stream in listener.incoming().flatten() {
@@ -372,10 +372,10 @@ pub(super) fn listen(
             std::thread::spawn(move || read_client(id, stream, jobs));
         }
     });
-    Ok(path)
+    Ok(Some(path))
 }
 
-fn read_client(client: usize, mut stream: UnixStream, jobs: Sender<Job>) {
+fn read_client(client: usize, mut stream: Stream, jobs: Sender<Job>) {
     let mut reader = FrameReader::<MAX_REQUEST_FRAME>::new();
     let mut buf = [0u8; 256];
     while let Ok(n) = stream.read(&mut buf) {

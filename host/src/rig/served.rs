@@ -5,7 +5,6 @@
 //! file beside the socket names the command, so `set` and `config set` refuse before they send.
 
 use std::io::Write as _;
-use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver};
 
@@ -13,6 +12,7 @@ use anyhow::Result;
 use kapitza_core::link::frame::{encode, Header};
 use kapitza_core::link::{Reason, Request, Response, Telemetry, MAX_RESPONSE_FRAME};
 
+use super::control_socket::Stream;
 use super::owner::{listen, socket_path, still_there, Job};
 use super::port::ReadWrite;
 use crate::link::{Client, Error};
@@ -22,9 +22,9 @@ pub struct Served {
     socket: PathBuf,
     marker: PathBuf,
     jobs: Receiver<Job>,
-    clients: Receiver<(usize, UnixStream)>,
+    clients: Receiver<(usize, Stream)>,
     /// Each client, and whether it asked for telemetry.
-    writers: Vec<(usize, UnixStream, bool)>,
+    writers: Vec<(usize, Stream, bool)>,
 }
 
 fn marker_path(port: &str) -> PathBuf {
@@ -39,20 +39,22 @@ pub fn busy(port: &str) -> Option<String> {
 
 impl Served {
     /// Serves `port`'s control socket; `busy` says what the command is doing (shown to the
-    /// commands it refuses).
-    pub fn open(port: &str, busy: &str) -> Result<Self> {
+    /// commands it refuses). None on a system without control sockets.
+    pub fn open(port: &str, busy: &str) -> Result<Option<Self>> {
         let (job_tx, jobs) = mpsc::channel();
         let (client_tx, clients) = mpsc::channel();
-        let socket = listen(port, job_tx, client_tx)?;
+        let Some(socket) = listen(port, job_tx, client_tx)? else {
+            return Ok(None);
+        };
         let marker = marker_path(port);
         std::fs::write(&marker, busy)?;
-        Ok(Self {
+        Ok(Some(Self {
             socket,
             marker,
             jobs,
             clients,
             writers: Vec::new(),
-        })
+        }))
     }
 
     pub fn socket(&self) -> &Path {
