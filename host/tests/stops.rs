@@ -11,7 +11,7 @@ use std::sync::mpsc::{self, Receiver};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use kapitza_test_support::binary::{json, Binary};
+use kapitza_test_support::binary::{interrupt_then_kill, json, Binary};
 use serde_json::Value;
 
 const KAPITZA: Binary = Binary(env!("CARGO_BIN_EXE_kapitza"));
@@ -104,18 +104,7 @@ impl Proc {
 
 impl Drop for Proc {
     fn drop(&mut self) {
-        if let Ok(None) = self.child.try_wait() {
-            self.signal(libc::SIGINT);
-            let deadline = Instant::now() + Duration::from_secs(2);
-            while Instant::now() < deadline {
-                if let Ok(Some(_)) = self.child.try_wait() {
-                    return;
-                }
-                std::thread::sleep(Duration::from_millis(10));
-            }
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
+        interrupt_then_kill(&mut self.child);
     }
 }
 

@@ -149,19 +149,28 @@ impl Running {
 }
 
 impl Drop for Running {
-    /// Ctrl-C first, so a server removes its symlink and an owner its socket; then a kill.
     fn drop(&mut self) {
-        self.sigint();
-        let deadline = Instant::now() + Duration::from_secs(2);
-        while Instant::now() < deadline {
-            if let Ok(Some(_)) = self.child.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        interrupt_then_kill(&mut self.child);
     }
+}
+
+/// Ends a child that may still run: Ctrl-C first, so a server removes its symlink and an owner
+/// its socket; a kill after 2 s.
+pub fn interrupt_then_kill(child: &mut Child) {
+    if let Ok(Some(_)) = child.try_wait() {
+        return;
+    }
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let deadline = Instant::now() + Duration::from_secs(2);
+    while Instant::now() < deadline {
+        if let Ok(Some(_)) = child.try_wait() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
 }
 
 /// Its stdout as JSON, or a panic showing both streams.

@@ -257,7 +257,8 @@ mod tests {
         }
     }
 
-    /// The issue's examples, refused with the key and the range.
+    /// Values that would switch a guard off (no link-loss stop, an over-current never acted on,
+    /// a watchdog firing before the first control tick), refused with the key and the range.
     #[test]
     fn issue_23s_values_are_refused_by_name() {
         let key = |f| key(f).to_string();
