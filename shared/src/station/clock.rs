@@ -43,11 +43,13 @@ impl SampleClock {
         self.due
     }
 
-    /// Sample k's deadline: `origin + floor(k·F/f)`, in 128 bits so no product overflows.
+    /// Sample k's deadline: `origin + floor(k·F/f)`, as `(k div f)·F + floor((k mod f)·F/f)`
+    /// so no product leaves 64 bits (the firmware has no 128-bit division to spare flash on).
     fn at(&self, k: u64) -> u64 {
-        let t = u128::from(k) * u128::from(self.tick_hz) / u128::from(self.sample_hz);
-        self.origin
-            .saturating_add(u64::try_from(t).unwrap_or(u64::MAX))
+        let (f, big_f) = (self.sample_hz, self.tick_hz);
+        let whole = (k / f).saturating_mul(big_f);
+        let part = (k % f).saturating_mul(big_f) / f;
+        self.origin.saturating_add(whole).saturating_add(part)
     }
 
     /// The sample due at [`Self::due`] ran at tick `now`: moves to the next deadline still
@@ -59,10 +61,14 @@ impl SampleClock {
             self.due = next;
             return (next, 0);
         }
-        // The first k with at(k) > now is k = ceil((now − origin + 1)·f / F): then k·F/f ≥
-        // now − origin + 1, a whole number, so its floor is too; and (k − 1)·F/f is below it.
-        let ahead = u128::from(now - self.origin + 1) * u128::from(self.sample_hz);
-        let k = u64::try_from(ahead.div_ceil(u128::from(self.tick_hz))).unwrap_or(u64::MAX);
+        // The first k with at(k) > now is k = ceil(d·f/F) with d = now − origin + 1: then
+        // k·F/f ≥ d, a whole number, so its floor is too; and (k − 1)·F/f is below it. Split
+        // as (d div F)·f + ceil((d mod F)·f/F) to stay in 64 bits.
+        let (f, big_f) = (self.sample_hz, self.tick_hz);
+        let d = now - self.origin + 1;
+        let k = (d / big_f)
+            .saturating_mul(f)
+            .saturating_add(((d % big_f) * f).div_ceil(big_f));
         let skipped = k - self.k - 1;
         self.k = k;
         self.due = self.at(k);
@@ -105,7 +111,10 @@ mod tests {
             let (t, skipped) = c.advance(prev);
             assert_eq!(skipped, 0);
             // t ≤ n·10^6/12 000 < t + 1, in integers.
-            assert!(t * 12_000 <= n * 1_000_000 && n * 1_000_000 < (t + 1) * 12_000, "n {n}: {t}");
+            assert!(
+                t * 12_000 <= n * 1_000_000 && n * 1_000_000 < (t + 1) * 12_000,
+                "n {n}: {t}"
+            );
             // Each period is 83 or 84 ticks (83.33 on average).
             assert!((83..=84).contains(&(t - prev)), "n {n}");
             prev = t;
@@ -142,7 +151,23 @@ mod tests {
         let now = 1_000_000_000_000u64 * 1_000_000 / 12_000;
         let (t, _) = c.advance(now);
         assert!(t > now && t - now <= 84);
-        assert_eq!(t, (c.k as u128 * 1_000_000 / 12_000) as u64);
+        assert_eq!(u128::from(t), u128::from(c.k) * 1_000_000 / 12_000);
+    }
+
+    #[test]
+    fn the_64_bit_split_is_the_closed_form() {
+        // floor(k·F/f) computed in 128 bits, for every rate in the range's corners and one
+        // that shares no factor with the tick, at k around whole seconds and far out.
+        for hz in [1_000u32, 7_001, 10_000, 12_000] {
+            let c = SampleClock::new(5, TICK_HZ, hz);
+            let f = u64::from(hz);
+            for base in [0, f, 1_000 * f, 1_000_000_007 * f] {
+                for k in base.saturating_sub(3)..base + 3 {
+                    let exact = u128::from(k) * u128::from(TICK_HZ) / u128::from(f);
+                    assert_eq!(u128::from(c.at(k) - 5), exact, "{hz} Hz, k {k}");
+                }
+            }
+        }
     }
 
     #[test]
