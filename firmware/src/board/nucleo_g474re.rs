@@ -6,15 +6,15 @@
 //!
 //! | signal | pin | peripheral | note |
 //! |---|---|---|---|
-//! | H-bridge EN (PWM) | PA8 | TIM1_CH1, 20 kHz | DRV8874 in PH/EN mode; TIM1 is the drive timer |
-//! | H-bridge PH (direction) | PA9 | GPIO out | |
+//! | H-bridge EN (PWM) | PA8 | TIM1_CH1, 20 kHz, speed Low | DRV8874 in PH/EN mode; TIM1 is the drive timer |
+//! | H-bridge PH (direction) | PA9 | GPIO out, speed Low | |
 //! | H-bridge nSLEEP | PA10 | GPIO out | low = bridge off (also at reset: board pull-down) |
 //! | H-bridge nFAULT | PA6 | TIM1_BKIN (AF6) | open drain, pulled up: low = fault, TIM1 break (outputs off in hardware) |
 //! | motor current (IPROPI) | PA0 | ADC1_IN1 | 1.5 kΩ to ground: 0.6825 V/A |
-//! | crank encoder A / B | PB6 / PB7 | TIM4_CH1/CH2, encoder mode | 2048 lines, 8192 counts per turn |
-//! | tilt servo | PB4 | TIM3_CH1, 50 Hz | pulse map from the calibration (reference: 500–2500 µs over 270°) |
-//! | pendulum encoder SCK / MISO / MOSI | PB13 / PB14 / PB15 | SPI2, mode 1, 5.3 MHz | AS5047P, 14 bit; MISO pulled up (a cut cable reads 0xFFFF) |
-//! | pendulum encoder CSn | PB12 | GPIO out | |
+//! | crank encoder A / B | PB6 / PB7 | TIM4_CH1/CH2, encoder mode, input filter 282 ns | 2048 lines, 8192 counts per turn |
+//! | tilt servo | PC6 (CN10 pin 4) | TIM3_CH1 (AF2), 50 Hz, speed Low | pulse map from the calibration (reference: 500–2500 µs over 270°); no pull at reset |
+//! | pendulum encoder SCK / MISO / MOSI | PB13 / PB14 / PB15 | SPI2, mode 1, 5.3 MHz, speed Medium | AS5047P, 14 bit; MISO pulled up (a cut cable reads 0xFFFF) |
+//! | pendulum encoder CSn | PB12 | GPIO out, speed Medium | setup, hold and high time from the cycle counter |
 //! | emergency stop | PB1 | GPIO in, pull-up (+ external 4.7 kΩ and RC) | normally-closed contact to GND: open = stop; read at every control tick |
 //! | laptop link TX / RX | PA2 / PA3 | USART2, 115200 8N1 | ST-LINK virtual COM port |
 //! | (time driver) | — | TIM2 | `time-driver-tim2` in Cargo.toml |
@@ -31,7 +31,7 @@ use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::timer::qei::{self, Qei};
-use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm, SimplePwmChannel};
+use embassy_stm32::timer::simple_pwm::{PwmPin, PwmPinConfig, SimplePwm, SimplePwmChannel};
 use embassy_stm32::usart::{self, BufferedUart};
 use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config, Peri, Peripherals};
 use static_cell::StaticCell;
@@ -39,8 +39,24 @@ use static_cell::StaticCell;
 pub const NAME: &str = "NUCLEO-G474RE";
 
 bind_interrupts!(struct Irqs {
-    USART2 => usart::BufferedInterruptHandler<peripherals::USART2>;
+    USART2 => LineErrors, usart::BufferedInterruptHandler<peripherals::USART2>;
 });
+
+/// Runs before embassy's buffered-UART handler on USART2's interrupt and passes a parity,
+/// framing, noise or overrun flag on as a line error. embassy-stm32 0.6's handler only logs
+/// these flags and clears them (its `read` never returns an error), so without this the rig
+/// would never hear of them. Reading ISR changes nothing; embassy clears the flags through
+/// ICR right after.
+pub struct LineErrors;
+
+impl interrupt::typelevel::Handler<interrupt::typelevel::USART2> for LineErrors {
+    unsafe fn on_interrupt() {
+        let isr = pac::USART2.isr().read();
+        if isr.pe() || isr.fe() || isr.ne() || isr.ore() {
+            crate::channels::LINE_ERROR.signal(());
+        }
+    }
+}
 
 /// The interrupt that runs the control loop's executor (UART4 is not used on this board), and
 /// its priority: above the thread-mode tasks, below the time driver and USART2.
@@ -55,8 +71,26 @@ unsafe fn UART4() {
 }
 
 /// Chip-select setup and hold around an AS5047P frame, and its high time between frames: the
-/// datasheet's tL, tH and tCSn are ≥ 350 ns ("SPI Timing"), 60 cycles at 170 MHz (352 ns).
+/// datasheet's tL, tH and tCSn are ≥ 350 ns ("SPI Timing"), 60 cycles at 170 MHz (352 ns),
+/// counted on DWT's cycle counter. (`cortex_m::asm::delay` counts loop iterations, whose cycles
+/// depend on the flash wait states and the ART cache: ~3× the budget here.)
 const CS_CYCLES: u32 = 60;
+
+/// Busy-waits at least `cycles` core clock cycles on DWT CYCCNT (started in [`split`]); the
+/// wrapping difference stays right across the counter's 25 s wrap.
+fn wait_cycles(cycles: u32) {
+    let start = cortex_m::peripheral::DWT::cycle_count();
+    while cortex_m::peripheral::DWT::cycle_count().wrapping_sub(start) < cycles {}
+}
+
+/// Starts DWT's cycle counter: trace enabled in DEMCR (TRCENA), then CYCCNTENA.
+fn start_cycle_counter() {
+    // SAFETY: only DEMCR.TRCENA and DWT_CTRL.CYCCNTENA are set, once at boot before any task
+    // runs; nothing else in the firmware owns DCB or DWT (a debugger also sets TRCENA).
+    let mut cp = unsafe { cortex_m::Peripherals::steal() };
+    cp.DCB.enable_trace();
+    cp.DWT.enable_cycle_counter();
+}
 
 /// SYSCLK = 170 MHz (the G474's maximum) from the board's 24 MHz crystal X3 (HSE).
 ///
@@ -182,11 +216,11 @@ impl PendulumBus {
     pub fn transfer(&mut self, word: u16) -> Result<u16, spi::Error> {
         let mut w = [word];
         self.cs.set_low();
-        cortex_m::asm::delay(CS_CYCLES);
+        wait_cycles(CS_CYCLES);
         let r = self.spi.blocking_transfer_in_place(&mut w);
-        cortex_m::asm::delay(CS_CYCLES);
+        wait_cycles(CS_CYCLES);
         self.cs.set_high();
-        cortex_m::asm::delay(CS_CYCLES);
+        wait_cycles(CS_CYCLES);
         r.map(|()| w[0])
     }
 }
@@ -228,10 +262,32 @@ pub struct Board {
     pub flash: Flash<'static, Blocking>,
 }
 
+/// Crank encoder input filter (TIM4 CCMR1 IC1F/IC2F): fDTS/8 sampled 6 times, 48 cycles at
+/// 170 MHz = 282 ns. The fastest legitimate edges come at the range table's top ω (1000 rad/s,
+/// `kapitza_core::rig::fields`): 159 rev/s × 8192 counts = 1.30 M counts/s, so one channel
+/// holds each level for 2 counts = 1.53 µs, or 1.15 µs with an encoder's ±45° duty error. The
+/// filter passes those with a factor 4 to spare and rejects shorter spikes (the motor's
+/// commutation, the bridge's 20 kHz switching edges); it delays both channels alike, by
+/// 282–329 ns, so no count is lost or reordered. The next step, fDTS/8 × 8 (376 ns), leaves
+/// a factor 3; fDTS/16 × 8 (753 ns) would eat the duty error's margin.
+const ENCODER_FILTER: FilterValue = FilterValue::FDTS_DIV8_N6;
+
 /// Splits the chip's peripherals into the tasks' resources.
 pub fn split(p: Peripherals) -> Board {
+    start_cycle_counter();
     // Drive: TIM1 CH1 PWM at 20 kHz (inaudible, well above the motor's electrical corner).
-    let en_pin = PwmPin::new(p.PA8, OutputType::PushPull);
+    // Speed Low (OSPEEDR 00, rated to 5 MHz into 50 pF: STM32G474 datasheet, "I/O AC
+    // characteristics"): 250 times the 20 kHz PWM, and the DRV8874's own output edges are far
+    // slower than the pin's. Slow edges on the cable to the bridge couple less into the
+    // encoder and sensor lines beside it. `PwmPin::new` would set VeryHigh.
+    let en_pin = PwmPin::new_with_config(
+        p.PA8,
+        PwmPinConfig {
+            output_type: OutputType::PushPull,
+            speed: Speed::Low,
+            pull: Pull::None,
+        },
+    );
     let pwm = SimplePwm::new(
         p.TIM1,
         Some(en_pin),
@@ -250,9 +306,15 @@ pub fn split(p: Peripherals) -> Board {
         ..Default::default()
     };
     let encoder = Qei::new(p.TIM4, p.PB6, p.PB7, qcfg);
+    // `Qei::new` leaves IC1F/IC2F at 0 (no filter); the filter is set before the first count.
+    pac::TIM4.ccmr_input(0).modify(|w| {
+        w.set_icf(0, ENCODER_FILTER);
+        w.set_icf(1, ENCODER_FILTER);
+    });
     let drive = Drive {
         estop: Input::new(p.PB1, Pull::Up),
         en,
+        // PH changes only with the duty's sign: the slowest edges.
         phase: Output::new(p.PA9, Level::Low, Speed::Low),
         sleep: Output::new(p.PA10, Level::Low, Speed::Low),
         encoder,
@@ -261,8 +323,18 @@ pub fn split(p: Peripherals) -> Board {
     };
 
     // Tilt servo: TIM3 CH1 at 50 Hz, no pulses until the control loop names its first θd (a
-    // pulse now would swing the mount: `kapitza_core::rig::servo`).
-    let servo_pin = PwmPin::new(p.PB4, OutputType::PushPull);
+    // pulse now would swing the mount: `kapitza_core::rig::servo`). On PC6 (AF2), which is an
+    // analog input with no pull from reset until here: PB4, TIM3_CH1's other pin, is NJTRST
+    // with its pull-up on at reset, so the servo would see a high line through every reset.
+    // Speed Low: a 500–2500 µs pulse needs no fast edge.
+    let servo_pin = PwmPin::new_with_config(
+        p.PC6,
+        PwmPinConfig {
+            output_type: OutputType::PushPull,
+            speed: Speed::Low,
+            pull: Pull::None,
+        },
+    );
     let pwm = SimplePwm::new(
         p.TIM3,
         Some(servo_pin),
@@ -281,9 +353,13 @@ pub fn split(p: Peripherals) -> Board {
     scfg.mode = spi::MODE_1;
     scfg.frequency = Hertz(5_000_000);
     scfg.miso_pull = Pull::Up;
+    // SCK, MOSI and CSn at speed Medium (OSPEEDR 01, rated to 25 MHz into 50 pF: STM32G474
+    // datasheet, "I/O AC characteristics"), 5 times the 5.3 MHz clock; Low is rated to 5 MHz,
+    // at the clock itself. embassy's default, VeryHigh, rings on 30 cm of cable for no gain.
+    scfg.gpio_speed = Speed::Medium;
     let pendulum = PendulumBus {
         spi: Spi::new_blocking(p.SPI2, p.PB13, p.PB15, p.PB14, scfg),
-        cs: Output::new(p.PB12, Level::High, Speed::VeryHigh),
+        cs: Output::new(p.PB12, Level::High, Speed::Medium),
     };
 
     let safety = SafetyIo { iwdg: p.IWDG };

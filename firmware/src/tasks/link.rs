@@ -2,8 +2,12 @@
 //!
 //! Framing, decoding, answers, telemetry and the version policy all live in the control loop's
 //! `kapitza_core::station::RigLoop`; this task only moves bytes between the UART and the two
-//! pipes. A UART error (overrun, framing, noise) is passed on as a line error, which drops the
-//! partial frame and counts it as bad; the task never stops.
+//! pipes; the task never stops. Line errors reach the rig loop as `LINE_ERROR` (which drops the
+//! partial frame and counts it in `frames_bad`) from two places: the UART's parity, framing,
+//! noise and overrun flags (`board::LineErrors`, on USART2's interrupt: embassy-stm32 0.6's
+//! buffered UART only logs them, and its `read` never fails), and bytes this task could not
+//! hand on. A full receive ring inside embassy's driver drops bytes without a flag; that frame
+//! fails its CRC (docs/rig.md, "Line errors").
 
 use defmt::info;
 use embassy_futures::select::{select, Either};
@@ -22,9 +26,11 @@ pub async fn run(uart: BufferedUart<'static>) {
     loop {
         match select(rx.read(&mut inbox), TO_LAPTOP.read(&mut outbox)).await {
             Either::First(Ok(n)) => {
-                // A full pipe means the control loop is stalled; the watchdog deals with that,
-                // and the bytes lost here fail their frame's CRC.
-                let _ = FROM_LAPTOP.try_write(&inbox[..n]);
+                // A full pipe means the control loop is stalled (the watchdog deals with that);
+                // the bytes lost here are a line error, and their frame fails its CRC.
+                if FROM_LAPTOP.try_write(&inbox[..n]) != Ok(n) {
+                    LINE_ERROR.signal(());
+                }
             }
             Either::First(Err(_)) => LINE_ERROR.signal(()),
             Either::Second(n) => {

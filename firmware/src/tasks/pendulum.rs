@@ -2,25 +2,23 @@
 //!
 //! The frames, the error flag and its clearing read, the diagnostics and the sensor's health
 //! are `kapitza_core::rig::as5047`, the count → angle map the rig loop's (with the
-//! configuration's calibration); this task keeps the sample clock and moves the words. Missed sample times are skipped, never caught up in a burst
-//! (`kapitza_core::station::next_due`), and the sample after a skip is marked late (an overrun
+//! configuration's calibration); this task keeps the sample clock and moves the words. The
+//! clock carries the tick's remainder (`kapitza_core::station::clock`), so a rate that does not
+//! divide embassy-time's 1 MHz tick (12 kHz) is exact on average. Missed sample times are
+//! skipped, never caught up in a burst, and the sample after a skip is marked late (an overrun
 //! in the status). Each sample carries the time its angle was latched (the frame before).
 
-use embassy_time::{Duration, Instant, Timer};
+use embassy_time::{Instant, Timer, TICK_HZ};
 use kapitza_core::rig::as5047::As5047;
-use kapitza_core::station::{next_due, Sample};
+use kapitza_core::station::clock::SampleClock;
+use kapitza_core::station::Sample;
 
 use crate::board::PendulumBus;
 use crate::channels::{SAMPLES, SAMPLE_HZ};
 
-fn period(hz: u32) -> Duration {
-    Duration::from_hz(u64::from(hz.max(1)))
-}
-
 #[embassy_executor::task]
 pub async fn run(mut bus: PendulumBus, sample_hz: u32) {
     let mut hz = defmt::unwrap!(SAMPLE_HZ.receiver());
-    let mut dt = period(sample_hz).as_ticks();
     let mut sensor = As5047::new();
     let mut held = 0u16;
     let mut late = false;
@@ -30,14 +28,13 @@ pub async fn run(mut bus: PendulumBus, sample_hz: u32) {
     // Prime the pipeline: the first answer belongs to no command of ours.
     let t0 = Instant::now();
     sensor.sample(t0.as_micros() as u32, |w| bus.transfer(w));
-    let mut due = t0.as_ticks();
+    let mut clock = SampleClock::new(t0.as_ticks(), TICK_HZ, sample_hz);
     loop {
-        let (next, skipped) = next_due(due, Instant::now().as_ticks(), dt);
-        due = next;
+        let (due, skipped) = clock.advance(Instant::now().as_ticks());
         late |= skipped > 0;
         Timer::at(Instant::from_ticks(due)).await;
         if let Some(new) = hz.try_changed() {
-            dt = period(new).as_ticks();
+            clock.set_rate(new);
         }
         let read = sensor.sample(Instant::now().as_micros() as u32, |w| bus.transfer(w));
         if let Ok(count) = read.count {

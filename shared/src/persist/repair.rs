@@ -88,29 +88,32 @@ pub fn repair(cfg: RigConfig) -> Result<(RigConfig, FieldSet), ConfigField> {
         ..RigConfig::REFERENCE
     };
     let kept = kept.validate().map_err(|_| last)?;
+    // A field took its default when setting it back changes the record: equal field for field,
+    // a NaN equal to itself, is compared as the wire images' bytes. The stored image is made
+    // once, outside the loop.
+    let mut x = [0u8; IMAGE];
+    let mut y = [0u8; IMAGE];
+    let before = image(&stored, &mut x);
     for f in ConfigField::ALL {
         let mut c = stored;
         restore_default(&mut c, f);
         let calibration =
             c.calibration != stored.calibration || c.closed_loop != stored.closed_loop;
-        if !calibration && !same(&c, &stored) {
+        if !calibration && (before.is_none() || image(&c, &mut y) != before) {
             defaulted.insert(f);
         }
     }
     Ok((kept, defaulted))
 }
 
-/// Equal field for field, a NaN equal to itself: compared as their wire images' bytes.
-fn same(a: &RigConfig, b: &RigConfig) -> bool {
-    use crate::link::WireConfig;
-    use postcard::experimental::max_size::MaxSize;
-    let mut x = [0u8; WireConfig::POSTCARD_MAX_SIZE];
-    let mut y = [0u8; WireConfig::POSTCARD_MAX_SIZE];
-    match (
-        postcard::to_slice(&WireConfig::from(*a), &mut x),
-        postcard::to_slice(&WireConfig::from(*b), &mut y),
-    ) {
-        (Ok(p), Ok(q)) => p == q,
-        _ => false,
-    }
+const IMAGE: usize =
+    <crate::link::WireConfig as postcard::experimental::max_size::MaxSize>::POSTCARD_MAX_SIZE;
+
+/// `cfg`'s wire image in `buf` (None if it does not serialise). Never inlined: one copy of the
+/// conversion and serialiser serves both calls above (inlined, each call carried its own).
+#[inline(never)]
+fn image<'a>(cfg: &RigConfig, buf: &'a mut [u8; IMAGE]) -> Option<&'a [u8]> {
+    postcard::to_slice(&crate::link::WireConfig::from(*cfg), buf)
+        .ok()
+        .map(|s| &*s)
 }

@@ -46,6 +46,7 @@
 //! running, then its verdict; the drive starts only on a pass. **Bring-up mode** drives the
 //! crank open loop at a capped duty and streams the sensors raw ([`Response::Raw`]).
 
+pub mod clock;
 pub mod drive;
 pub mod precheck;
 pub mod repeat;
