@@ -120,11 +120,14 @@ extern "C" fn fault_entry(stacked_pc: u32, exception: u32) -> ! {
     }
     .crash(stacked_pc);
     record(crash);
-    if exception == 0 {
-        defmt::error!("HardFault: {}, CFSR = {=u32:#x}", crash, cfsr);
-    } else {
-        defmt::error!("MemManage: {}, CFSR = {=u32:#x}", crash, cfsr);
-    }
+    // Numbers only (the next boot logs the record too): exception 0 HardFault, 1 MemManage.
+    defmt::error!(
+        "fault: exception {=u32}, stacked pc {=u32:#x}, CFSR {=u32:#x}, MMFAR {=u32:#x}",
+        exception,
+        stacked_pc,
+        cfsr,
+        mmfar
+    );
     reset_after_log()
 }
 

@@ -64,8 +64,8 @@ async fn main(spawner: Spawner) {
     let kept = retained::load();
     let reset = ResetInfo::new(cause, kept.and_then(|k| k.last_fault));
     info!("reset cause: {}", reset.cause);
-    if let Some(c) = crash {
-        warn!("the firmware failed before this reset: {}", c);
+    if let Some(pc) = reset.fault_pc {
+        warn!("the fault before this reset was taken at pc {=u32:#x}", pc);
     }
     if let Some(k) = kept {
         info!(
