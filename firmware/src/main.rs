@@ -24,8 +24,9 @@ use defmt::{info, unwrap, warn};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::pac;
-use kapitza_core::link::message::{ResetCause, ResetInfo};
+use kapitza_core::link::message::ResetInfo;
 use kapitza_core::persist::ConfigOrigin;
+use kapitza_core::rig::retained::ResetFlags;
 use kapitza_core::rig::servo;
 
 /// Firmware version, from this crate's Cargo.toml.
@@ -36,15 +37,36 @@ pub static CONTROL_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
+    // ---- Before the clocks: a first log line (defmt-rtt needs no clock), the stack guard,
+    // and the option bytes this firmware was built for. `embassy_stm32::init` waits for the
+    // crystal without a timeout: a board whose log ends at this line is waiting for its HSE.
+    info!(
+        "kapitza firmware v{=str} on {=str}: starting clocks (HSE 24 MHz)",
+        VERSION,
+        board::NAME
+    );
+    fail_safe::enable_stack_guard();
+    check_option_bytes();
+    // ----
     let p = embassy_stm32::init(board::chip_config());
-    info!("kapitza firmware v{=str} on {=str}", VERSION, board::NAME);
+    info!("clocks running");
+    // A CPU lock-up (a fault inside the HardFault handler) breaks TIM1 like nFAULT does, so
+    // the drive stops in hardware (SYSCFG_CFGR2.CLL, RM0440 "SYSCFG configuration register 2";
+    // the bit stays set until the next reset).
+    pac::RCC.apb2enr().modify(|w| w.set_syscfgen(true));
+    pac::SYSCFG.cfgr2().modify(|w| w.set_cll(true));
     // A debugger halting the core freezes the watchdog (so a breakpoint does not reset the
     // chip) and TIM1 (whose outputs are then disabled, as if MOE were cleared).
     pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
     pac::DBGMCU.apb2fzr().modify(|w| w.set_tim1(true));
-    let cause = reset_cause();
-    info!("reset cause: {}", cause);
+    let crash = retained::take_crash();
+    let cause = kapitza_core::rig::retained::cause(reset_flags(), crash);
     let kept = retained::load();
+    let reset = ResetInfo::new(cause, kept.and_then(|k| k.last_fault));
+    info!("reset cause: {}", reset.cause);
+    if let Some(pc) = reset.fault_pc {
+        warn!("the fault before this reset was taken at pc {=u32:#x}", pc);
+    }
     if let Some(k) = kept {
         info!(
             "before the reset: theta_d = {=f32} deg, last fault {}",
@@ -69,10 +91,6 @@ async fn main(spawner: Spawner) {
 
     let control = CONTROL_EXECUTOR.start(board::CONTROL_IRQ);
     control.spawn(unwrap!(tasks::pendulum::run(b.pendulum, cfg.sample_hz)));
-    let reset = ResetInfo {
-        cause,
-        last_fault: kept.and_then(|k| k.last_fault).map(Into::into),
-    };
     control.spawn(unwrap!(tasks::control::run(
         b.drive, cfg, origin, theta_d0, kept, reset
     )));
@@ -83,23 +101,44 @@ async fn main(spawner: Spawner) {
     spawner.spawn(unwrap!(tasks::persist::run(b.flash)));
 }
 
-/// Why the chip last reset (RCC_CSR's flags, cleared here so the next reset reports its own).
-/// A power-on sets BORRSTF and PINRSTF together (RM0440, "RCC_CSR"): brown-out is checked
-/// before the pin.
-fn reset_cause() -> ResetCause {
+/// The chip's reset flags (RCC_CSR), cleared here so the next reset reports its own.
+fn reset_flags() -> ResetFlags {
     let csr = pac::RCC.csr().read();
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    if csr.iwdgrstf() {
-        ResetCause::Watchdog
-    } else if csr.sftrstf() {
-        ResetCause::Software
-    } else if csr.wwdgrstf() || csr.lpwrrstf() || csr.oblrstf() {
-        ResetCause::Other
-    } else if csr.borrstf() {
-        ResetCause::PowerOn
-    } else if csr.pinrstf() {
-        ResetCause::Pin
-    } else {
-        ResetCause::Other
+    ResetFlags {
+        independent_watchdog: csr.iwdgrstf(),
+        window_watchdog: csr.wwdgrstf(),
+        software: csr.sftrstf(),
+        low_power: csr.lpwrrstf(),
+        option_load: csr.oblrstf(),
+        brown_out: csr.borrstf(),
+        pin: csr.pinrstf(),
+    }
+}
+
+/// Stops here, before the clocks, on a chip whose option bytes this firmware was not built
+/// for, saying so in the log (RDP and DBANK of FLASH_OPTR, RM0440 "Flash option register"):
+/// * DBANK = 0 (single bank, 4 KiB pages): this build addresses flash as dual bank (2 KiB
+///   pages), so storing the configuration would erase the wrong 4 KiB, possibly code;
+/// * RDP ≠ level 0 (0xAA): the probe can neither read the configuration page for its backup
+///   nor program the chip, and the stored configuration could not be recovered.
+///
+/// The outputs are safe as they are: no pin has been configured, and the bridge's nSLEEP
+/// has its pull-down. The watchdog is not started, so the chip stays here until the option
+/// bytes are set right (`kapitza flash` names the fix) and it is reset.
+fn check_option_bytes() {
+    let optr = pac::FLASH.optr().read();
+    let rdp = optr.rdp().to_bits();
+    let dual_bank = optr.dbank();
+    if dual_bank && rdp == 0xAA {
+        return;
+    }
+    defmt::error!(
+        "option bytes: DBANK = {=bool}, RDP = {=u8:#x}; this firmware needs DBANK = 1 and RDP = 0xaa: not starting",
+        dual_bank,
+        rdp
+    );
+    loop {
+        cortex_m::asm::nop();
     }
 }

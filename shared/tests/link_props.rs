@@ -253,6 +253,7 @@ fn status() -> impl Strategy<Value = Status> {
             proptest::option::of(fault()),
             proptest::option::of(check()),
             proptest::option::of(any::<i16>()),
+            proptest::option::of(any::<u32>()),
         ),
     )
         .prop_map(|(a, b, c, r)| Status {
@@ -276,6 +277,7 @@ fn status() -> impl Strategy<Value = Status> {
             reset: ResetInfo {
                 cause: r.0,
                 last_fault: r.1,
+                fault_pc: r.4,
             },
             check: r.2,
             bring_up: r.3,
@@ -288,7 +290,10 @@ fn reset_cause() -> impl Strategy<Value = ResetCause> {
         Just(ResetCause::Pin),
         Just(ResetCause::Watchdog),
         Just(ResetCause::Software),
-        Just(ResetCause::Other)
+        Just(ResetCause::Other),
+        Just(ResetCause::Panic),
+        Just(ResetCause::HardFault),
+        Just(ResetCause::StackOverflow)
     ]
 }
 

@@ -232,6 +232,7 @@ fn status_and_telemetry_in_wire_units() {
     let after_watchdog = kapitza_core::link::message::ResetInfo {
         cause: kapitza_core::link::message::ResetCause::Watchdog,
         last_fault: Some(kapitza_core::link::message::Fault::Stall),
+        fault_pc: None,
     };
     let s = status(
         &r,

@@ -47,5 +47,8 @@ pub fn reset_name(c: &ResetCause) -> &'static str {
         ResetCause::Watchdog => "watchdog",
         ResetCause::Software => "software",
         ResetCause::Other => "other",
+        ResetCause::Panic => "panic",
+        ResetCause::HardFault => "hard_fault",
+        ResetCause::StackOverflow => "stack_overflow",
     }
 }

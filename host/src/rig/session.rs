@@ -200,10 +200,14 @@ pub struct StatusView {
     /// (their `config get` keys); empty when none did.
     pub config_fallbacks: Vec<&'static str>,
     pub uptime_s: f64,
-    /// Why the rig last reset (`"power_on"`, `"pin"`, `"watchdog"`, `"software"`, `"other"`),
-    /// and the fault latched before that reset, or null.
+    /// Why the rig last reset (`"power_on"`, `"pin"`, `"watchdog"`, `"software"`, `"other"`,
+    /// `"panic"`, `"hard_fault"`, `"stack_overflow"`), and the fault latched before that
+    /// reset, or null.
     pub reset_cause: &'static str,
     pub fault_before_reset: Option<&'static str>,
+    /// After a hard fault or stack overflow, the program counter it was taken at
+    /// (`"0x08001234"`), when known; else null.
+    pub fault_pc: Option<String>,
     pub frames_ok: u32,
     pub frames_bad: u32,
     pub frames_dropped: u32,
@@ -269,6 +273,7 @@ impl StatusView {
             uptime_s: f64::from(s.uptime_ms) / 1000.0,
             reset_cause: reset_name(&s.reset.cause),
             fault_before_reset: s.reset.last_fault.as_ref().map(fault_name),
+            fault_pc: s.reset.fault_pc.map(|pc| format!("{pc:#010x}")),
             frames_ok: s.counters.frames_ok,
             frames_bad: s.counters.frames_bad,
             frames_dropped: s.counters.frames_dropped,
@@ -360,8 +365,12 @@ impl StatusView {
         }
         if self.reset_cause != "power_on" {
             s += &format!(
-                "\nreset       last reset: {}{}",
+                "\nreset       last reset: {}{}{}",
                 self.reset_cause,
+                self.fault_pc
+                    .as_ref()
+                    .map(|pc| format!(" at pc {pc}"))
+                    .unwrap_or_default(),
                 self.fault_before_reset
                     .map(|f| format!(" after the fault {f}"))
                     .unwrap_or_default()
@@ -419,5 +428,59 @@ mod tests {
             "{}",
             view.text()
         );
+    }
+
+    /// The reset's cause and PC as the status JSON spells them: `reset_cause` by name,
+    /// `fault_pc` as eight hex digits, null when the PC is not known or there was no crash.
+    #[test]
+    fn a_crash_is_named_with_its_pc() {
+        use kapitza_core::link::message::ResetInfo;
+        use kapitza_core::rig::retained::{Cause, Crash, CrashKind};
+        let cfg = RigConfig::REFERENCE;
+        let crash = |kind, pc| Cause::Crash(Crash { kind, pc });
+        let cases = [
+            (
+                crash(CrashKind::HardFault, Some(0x0800_1234)),
+                "hard_fault",
+                Some("0x08001234"),
+            ),
+            (crash(CrashKind::Panic, None), "panic", None),
+            (
+                crash(CrashKind::StackOverflow, None),
+                "stack_overflow",
+                None,
+            ),
+            (Cause::Watchdog, "watchdog", None),
+        ];
+        for (cause, name, pc) in cases {
+            let mut rig = RigServer::new(
+                cfg,
+                ConfigOrigin::Stored,
+                Angle::ZERO,
+                Clock::single(0, 0),
+                [0, 1, 0],
+            );
+            rig.reset = ResetInfo::new(cause, None);
+            let view = StatusView::new(&rig.status(false, 0), None, &cfg);
+            let json = serde_json::to_value(&view).unwrap();
+            assert_eq!(json["reset_cause"], name);
+            assert_eq!(json["fault_pc"], serde_json::json!(pc));
+            assert!(view.text().contains(&format!("last reset: {name}")));
+        }
+        let view = StatusView::new(
+            &RigServer::new(
+                cfg,
+                ConfigOrigin::Stored,
+                Angle::ZERO,
+                Clock::single(0, 0),
+                [0, 1, 0],
+            )
+            .status(false, 0),
+            None,
+            &cfg,
+        );
+        let json = serde_json::to_value(&view).unwrap();
+        assert_eq!(json["reset_cause"], "power_on");
+        assert_eq!(json["fault_pc"], serde_json::Value::Null);
     }
 }

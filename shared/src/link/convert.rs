@@ -2,8 +2,8 @@
 //! and the I16F16 / degree conversions at the boundary.
 
 use super::message::{
-    Fault, Mode, RMethod, SensorDiagnostics, StopReason, WireCalibration, WireClosedLoop,
-    WireConfig, WireGeometry, Q16,
+    Fault, Mode, RMethod, ResetCause, ResetInfo, SensorDiagnostics, StopReason, WireCalibration,
+    WireClosedLoop, WireConfig, WireGeometry, Q16,
 };
 use super::reason::{ConfigField, Reason};
 use crate::model::{self, Geometry};
@@ -13,6 +13,7 @@ use crate::rig::closed_loop::ClosedLoopR;
 use crate::rig::config::{Limits, MotorConfig, RigConfig};
 use crate::rig::estimator::Tuning;
 use crate::rig::fixed::Angle;
+use crate::rig::retained;
 use crate::rig::safety;
 use crate::rig::servo::ServoMap;
 use crate::ParamError;
@@ -50,6 +51,33 @@ impl From<safety::Fault> for Fault {
             safety::Fault::PhaseLockLost => Self::PhaseLockLost,
             safety::Fault::OverCurrentRms => Self::OverCurrentRms,
             safety::Fault::DutyCeiling => Self::DutyCeiling,
+        }
+    }
+}
+
+impl ResetInfo {
+    /// The status's reset information from the reset's cause and the fault retained across it.
+    pub fn new(cause: retained::Cause, last_fault: Option<safety::Fault>) -> Self {
+        use retained::{Cause as C, CrashKind as K};
+        let (cause, fault_pc) = match cause {
+            C::PowerOn => (ResetCause::PowerOn, None),
+            C::Pin => (ResetCause::Pin, None),
+            C::Watchdog => (ResetCause::Watchdog, None),
+            C::Software => (ResetCause::Software, None),
+            C::Other => (ResetCause::Other, None),
+            C::Crash(c) => (
+                match c.kind {
+                    K::Panic => ResetCause::Panic,
+                    K::HardFault => ResetCause::HardFault,
+                    K::StackOverflow => ResetCause::StackOverflow,
+                },
+                c.pc,
+            ),
+        };
+        Self {
+            cause,
+            last_fault: last_fault.map(Into::into),
+            fault_pc,
         }
     }
 }
@@ -401,5 +429,37 @@ impl WireConfig {
     /// The configuration this describes, if [`RigConfig::validate`] accepts it.
     pub fn to_valid(self) -> Result<RigConfig, Reason> {
         RigConfig::from(self).validate().map_err(Reason::from)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rig::retained::{Cause, Crash, CrashKind};
+
+    #[test]
+    fn reset_info_carries_the_crash_and_its_pc() {
+        let crash = |kind, pc| Cause::Crash(Crash { kind, pc });
+        let cases = [
+            (Cause::Watchdog, ResetCause::Watchdog, None),
+            (Cause::Software, ResetCause::Software, None),
+            (crash(CrashKind::Panic, None), ResetCause::Panic, None),
+            (
+                crash(CrashKind::HardFault, Some(0x0800_1234)),
+                ResetCause::HardFault,
+                Some(0x0800_1234),
+            ),
+            (
+                crash(CrashKind::StackOverflow, None),
+                ResetCause::StackOverflow,
+                None,
+            ),
+        ];
+        for (cause, want, pc) in cases {
+            let r = ResetInfo::new(cause, Some(safety::Fault::Stall));
+            assert_eq!((r.cause, r.fault_pc), (want, pc), "{cause:?}");
+            assert_eq!(r.last_fault, Some(Fault::Stall));
+        }
+        assert_eq!(ResetInfo::new(Cause::PowerOn, None), ResetInfo::POWER_ON);
     }
 }

@@ -219,6 +219,9 @@ pub struct SensorDiagnostics {
 pub struct ResetInfo {
     pub cause: ResetCause,
     pub last_fault: Option<Fault>,
+    /// After [`ResetCause::HardFault`] or [`ResetCause::StackOverflow`]: the program counter
+    /// the fault was taken at, when the exception frame was stacked intact.
+    pub fault_pc: Option<u32>,
 }
 
 /// The cause of the last reset.
@@ -235,6 +238,13 @@ pub enum ResetCause {
     Software,
     /// Another cause (low-power, option-byte load, window watchdog).
     Other,
+    /// The firmware panicked; its handler switched the outputs off and reset the chip.
+    Panic,
+    /// A HardFault (or an NMI other than the configuration read's ECC error); its handler
+    /// switched the outputs off and reset the chip.
+    HardFault,
+    /// The stack ran into its guard region below it (the MPU's MemManage fault).
+    StackOverflow,
 }
 
 impl ResetInfo {
@@ -242,6 +252,7 @@ impl ResetInfo {
     pub const POWER_ON: Self = Self {
         cause: ResetCause::PowerOn,
         last_fault: None,
+        fault_pc: None,
     };
 }
 

@@ -21,7 +21,8 @@
 //! | [`r_trim`] | closed-loop R: once settled, ω trimmed so the in-situ R equals the R asked for, within a band and a rate limit |
 //! | [`controller`] | one rig: the above composed into a sample tick and a control tick |
 //! | [`servo`] | θd → the tilt servo's pulse; the θd the rig starts from after a reset |
-//! | [`retained`] | the last θd and fault, kept in RAM across a reset with a CRC |
+//! | [`retained`] | the last θd and fault, and what made the firmware fail, kept in RAM across a reset with a CRC; the reset's cause |
+//! | [`watchdog`] | the independent watchdog's timeout from the control period and the flash's longest blocking step |
 //!
 //! # Rates (why these)
 //!
@@ -49,3 +50,4 @@ pub mod r_trim;
 pub mod retained;
 pub mod safety;
 pub mod servo;
+pub mod watchdog;

@@ -217,6 +217,13 @@ impl SimRig {
         self
     }
 
+    /// The same rig booted after a reset of `reset` (a crash's cause and PC, say), reported in
+    /// its status as the firmware reports its own ([`RigLoop::after_reset`]).
+    pub fn after_reset(mut self, reset: crate::link::message::ResetInfo) -> Self {
+        self.rig = self.rig.after_reset(reset);
+        self
+    }
+
     /// Seconds since power-up.
     pub fn seconds(&self) -> f64 {
         self.k as f64 / f64::from(self.rig.sample_hz())

@@ -44,6 +44,7 @@ pub fn status() -> Status {
         reset: ResetInfo {
             cause: ResetCause::Watchdog,
             last_fault: Some(Fault::PhaseLockLost),
+            fault_pc: None,
         },
         check: Some(Check::Passed),
         bring_up: None,
@@ -296,6 +297,31 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
     s.check = None;
     s.bring_up = Some(3_277);
     v.push(("status_bring_up", 190, Resp(Response::Status(s))));
+    // The resets a fault handler leaves: with a PC, and without one.
+    for (i, (name, cause, pc)) in [
+        ("status_after_panic", ResetCause::Panic, None),
+        (
+            "status_after_hard_fault",
+            ResetCause::HardFault,
+            Some(0x0800_1234),
+        ),
+        (
+            "status_after_stack_overflow",
+            ResetCause::StackOverflow,
+            None,
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut s = status();
+        s.reset = ResetInfo {
+            cause,
+            last_fault: None,
+            fault_pc: pc,
+        };
+        v.push((name, 191 + i as u8, Resp(Response::Status(s))));
+    }
     v
 }
 
