@@ -466,4 +466,433 @@ fn a_silent_port_times_out_with_a_hint() {
         panic!("a missing port answered");
     };
     assert!(format!("{e:#}").contains("did not answer"), "{e:#}");
+    // The case `kapitza flash` diagnoses through the probe; a protocol mismatch is not it.
+    assert!(confirm::is_silent(&e));
+    let other = anyhow::Error::from(Failure::new(Exit::NoRig, "no serial port found"));
+    assert!(!confirm::is_silent(&other));
+}
+
+// ---- The probe seam: backup, option bytes, erase, a silent board's diagnosis ----
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use kapitza::flash::backup::{self, Backup, Options};
+use kapitza::flash::board::Board;
+use kapitza::flash::diagnose::{self, Cause};
+use kapitza::flash::memory_map::{MemoryMap, Region};
+use kapitza::flash::option_bytes::{OptionBytes, FLASH_OPTR};
+
+/// FLASH_OPTR of a factory-fresh STM32G474, 0xFFEF_F8AA (the factory value RM0440 §5.7.8
+/// gives for category 3 devices): RDP = 0xAA (level 0) and DBANK = 1 are the bits that matter
+/// here; the other user options do not change the check.
+const OPTR_FRESH: u32 = 0xFFEF_F8AA;
+/// DBANK, bit 22 (RM0440 §5.7.8).
+const DBANK: u32 = 1 << 22;
+/// RCC_CR (RM0440 §7.4.1) at 0x4002_1000: HSEON bit 16, HSERDY bit 17.
+const RCC_CR: u64 = 0x4002_1000;
+
+/// A target without a probe: a sparse memory, a core at `pc`, and a log of what was done.
+struct FakeBoard {
+    words: BTreeMap<u64, u32>,
+    area: Option<Vec<u8>>,
+    area_start: u64,
+    pc: u64,
+    halted: bool,
+    log: Vec<String>,
+}
+
+impl FakeBoard {
+    fn new(optr: u32, area: Option<Vec<u8>>) -> Self {
+        Self {
+            words: BTreeMap::from([(FLASH_OPTR, optr)]),
+            area,
+            area_start: config_area().start,
+            pc: 0,
+            halted: false,
+            log: Vec::new(),
+        }
+    }
+}
+
+impl Board for FakeBoard {
+    fn read(&mut self, address: u64, buf: &mut [u8]) -> anyhow::Result<()> {
+        let area = self
+            .area
+            .as_ref()
+            .ok_or_else(|| anyhow::anyhow!("ST-LINK: SWD fault"))?;
+        let off = (address - self.area_start) as usize;
+        buf.copy_from_slice(&area[off..off + buf.len()]);
+        self.log.push(format!("read {address:#x} {}", buf.len()));
+        Ok(())
+    }
+    fn read_word(&mut self, address: u64) -> anyhow::Result<u32> {
+        self.words
+            .get(&address)
+            .copied()
+            .ok_or_else(|| anyhow::anyhow!("no word at {address:#x}"))
+    }
+    fn halt_pc(&mut self) -> anyhow::Result<u64> {
+        self.halted = true;
+        self.log.push("halt".into());
+        Ok(self.pc)
+    }
+    fn resume(&mut self) -> anyhow::Result<()> {
+        self.halted = false;
+        self.log.push("resume".into());
+        Ok(())
+    }
+    fn erase(&mut self, region: Region) -> anyhow::Result<()> {
+        self.log
+            .push(format!("erase {:#x}..{:#x}", region.start, region.end));
+        if let Some(a) = &mut self.area {
+            a.fill(0xFF);
+        }
+        Ok(())
+    }
+    fn write_flash(&mut self, address: u64, data: &[u8]) -> anyhow::Result<()> {
+        self.log.push(format!("write {address:#x} {}", data.len()));
+        self.area = Some(data.to_vec());
+        Ok(())
+    }
+}
+
+fn config_area() -> Region {
+    MemoryMap::firmware().config_page
+}
+
+/// An area holding something: a record's first bytes, the rest erased.
+fn stored_area() -> Vec<u8> {
+    let mut a = vec![0xFF; config_area().len() as usize];
+    a[..8].copy_from_slice(b"KPZC\x01\x00\x10\x00");
+    a
+}
+
+fn options(dir: &std::path::Path) -> Options {
+    Options {
+        area: config_area(),
+        dir: dir.to_path_buf(),
+        board: "0670FF3632".into(),
+        no_backup: false,
+        erase: false,
+        restore: None,
+    }
+}
+
+fn saved_path(b: &Backup) -> PathBuf {
+    match b {
+        Backup::Saved { path, .. } => path.clone(),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn two_backups_are_two_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = options(dir.path());
+    let mut a = Vec::new();
+    for _ in 0..2 {
+        let mut board = FakeBoard::new(OPTR_FRESH, Some(stored_area()));
+        let p = backup::prepare(&mut board, &opts).unwrap();
+        a.push(saved_path(&p.backup));
+        // The whole area, in one read, and no erase without --erase-config.
+        assert_eq!(
+            board.log,
+            [format!(
+                "read {:#x} {}",
+                config_area().start,
+                config_area().len()
+            )]
+        );
+        assert!(!p.erased);
+    }
+    assert_ne!(a[0], a[1]);
+    for p in &a {
+        assert_eq!(std::fs::read(p).unwrap(), stored_area());
+        let name = p.file_name().unwrap().to_str().unwrap();
+        assert!(
+            name.starts_with("config-0670FF3632-") && name.ends_with(".bin"),
+            "{name}"
+        );
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+#[test]
+fn a_blank_area_is_no_stored_configuration_and_saves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    // Erased flash reads all ones.
+    let mut board = FakeBoard::new(OPTR_FRESH, Some(vec![0xFF; config_area().len() as usize]));
+    let p = backup::prepare(&mut board, &options(dir.path())).unwrap();
+    assert_eq!(
+        p.backup,
+        Backup::Blank {
+            bytes: config_area().len()
+        }
+    );
+    assert!(p.backup.text().contains("no stored configuration"));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn a_failed_read_stops_unless_no_backup() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut board = FakeBoard::new(OPTR_FRESH, None);
+    let mut opts = options(dir.path());
+    opts.erase = true;
+    let e = backup::prepare(&mut board, &opts).unwrap_err();
+    assert_eq!(e.downcast_ref::<Failure>().unwrap().exit, Exit::NoRig);
+    let msg = format!("{e:#}");
+    assert!(
+        msg.contains("not backed up") && msg.contains("--no-backup") && msg.contains("SWD fault"),
+        "{msg}"
+    );
+    // Nothing erased when the backup failed.
+    assert!(
+        board.log.iter().all(|l| !l.starts_with("erase")),
+        "{:?}",
+        board.log
+    );
+
+    opts.no_backup = true;
+    let p = backup::prepare(&mut board, &opts).unwrap();
+    assert!(matches!(&p.backup, Backup::Unread { error } if error.contains("SWD fault")));
+    assert!(p.backup.text().contains("NOT backed up"));
+}
+
+#[test]
+fn erase_config_erases_the_area_after_the_backup() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut board = FakeBoard::new(OPTR_FRESH, Some(stored_area()));
+    let mut opts = options(dir.path());
+    opts.erase = true;
+    let p = backup::prepare(&mut board, &opts).unwrap();
+    let a = config_area();
+    assert_eq!(
+        board.log,
+        [
+            format!("read {:#x} {}", a.start, a.len()),
+            format!("erase {:#x}..{:#x}", a.start, a.end)
+        ]
+    );
+    assert!(p.erased);
+    // The backup holds what was there before the erase.
+    assert_eq!(std::fs::read(saved_path(&p.backup)).unwrap(), stored_area());
+}
+
+#[test]
+fn restore_config_writes_a_backup_back_and_refuses_a_wrong_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let saved = backup::save(dir.path(), "b", &stored_area()).unwrap();
+    let mut board = FakeBoard::new(OPTR_FRESH, Some(vec![0xFF; config_area().len() as usize]));
+    let mut opts = options(dir.path());
+    opts.restore = Some(saved.clone());
+    let p = backup::prepare(&mut board, &opts).unwrap();
+    assert!(p.erased);
+    assert_eq!(backup::restore(&mut board, &opts).unwrap(), Some(saved));
+    assert_eq!(board.area.as_deref(), Some(&stored_area()[..]));
+
+    let short = dir.path().join("short.bin");
+    std::fs::write(&short, [0u8; 100]).unwrap();
+    opts.restore = Some(short);
+    let mut board = FakeBoard::new(OPTR_FRESH, Some(stored_area()));
+    let e = format!("{:#}", backup::prepare(&mut board, &opts).unwrap_err());
+    assert!(
+        e.contains("100 bytes") && e.contains("nothing was written"),
+        "{e}"
+    );
+    assert!(board.log.is_empty(), "{:?}", board.log);
+}
+
+/// RM0440 §5.7.8: RDP bits 7:0 (0xAA level 0, 0xCC level 2, any other value level 1), DBANK
+/// bit 22.
+#[test]
+fn option_bytes_decode_and_refuse() {
+    let cases = [
+        (OPTR_FRESH, 0, true),
+        ((OPTR_FRESH & !0xFF) | 0xCC, 2, true),
+        ((OPTR_FRESH & !0xFF) | 0xBB, 1, true),
+        (OPTR_FRESH & !0xFF, 1, true),
+        (OPTR_FRESH & !DBANK, 0, false),
+    ];
+    for (optr, level, dbank) in cases {
+        let o = OptionBytes::decode(optr);
+        assert_eq!((o.rdp_level, o.dbank), (level, dbank), "{optr:#x}");
+        let r = o.check();
+        assert_eq!(r.is_ok(), level == 0 && dbank, "{optr:#x}");
+        if let Err(e) = r {
+            assert_eq!(e.downcast_ref::<Failure>().unwrap().exit, Exit::Refused);
+            let m = e.to_string();
+            assert!(m.contains("nothing was written"), "{m}");
+            match (level, dbank) {
+                (1, _) => assert!(m.contains("level 1") && m.contains("RDP=0xAA"), "{m}"),
+                (2, _) => assert!(m.contains("level 2") && m.contains("no tool"), "{m}"),
+                _ => assert!(m.contains("DBANK = 0") && m.contains("DBANK=1"), "{m}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn a_protected_chip_is_refused_before_the_backup() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut board = FakeBoard::new((OPTR_FRESH & !0xFF) | 0xBB, Some(stored_area()));
+    let mut opts = options(dir.path());
+    opts.erase = true;
+    let e = backup::prepare(&mut board, &opts).unwrap_err();
+    assert!(e.to_string().contains("level 1"), "{e}");
+    assert!(board.log.is_empty(), "{:?}", board.log);
+}
+
+/// A small Arm ELF with function symbols at the addresses given (Thumb bit set, as rustc
+/// emits them) and their sizes.
+fn symbol_elf(symbols: &[(&str, u64, u64)]) -> Vec<u8> {
+    use object::write::{Object, Symbol, SymbolSection};
+    use object::{Architecture, BinaryFormat, SectionKind, SymbolFlags, SymbolKind, SymbolScope};
+    let mut obj = Object::new(BinaryFormat::Elf, Architecture::Arm, Endianness::Little);
+    let text = obj.add_section(Vec::new(), b".text".to_vec(), SectionKind::Text);
+    for &(name, addr, size) in symbols {
+        obj.add_symbol(Symbol {
+            name: name.as_bytes().to_vec(),
+            value: addr | 1,
+            size,
+            kind: SymbolKind::Text,
+            scope: SymbolScope::Linkage,
+            weak: false,
+            section: SymbolSection::Section(text),
+            flags: SymbolFlags::None,
+        });
+    }
+    obj.write().unwrap()
+}
+
+fn symbols() -> Vec<u8> {
+    symbol_elf(&[
+        (
+            "_ZN13embassy_stm323rcc4init17h0123456789abcdefE",
+            0x0800_1000,
+            0x200,
+        ),
+        ("HardFault_", 0x0800_2000, 0x10),
+        ("rust_begin_unwind", 0x0800_3000, 0x40),
+        (
+            "_ZN16kapitza_firmware4main17hfedcba9876543210E",
+            0x0800_4000,
+            0x100,
+        ),
+    ])
+}
+
+/// The board at `pc` with RCC_CR `cr`: the diagnosis, and the core running again.
+fn diagnose_at(pc: u64, cr: Option<u32>) -> diagnose::Diagnosis {
+    let mut board = FakeBoard::new(OPTR_FRESH, None);
+    board.pc = pc;
+    if let Some(cr) = cr {
+        board.words.insert(RCC_CR, cr);
+    }
+    let d = diagnose::diagnose(&mut board, &symbols()).unwrap();
+    assert_eq!(board.log, ["halt", "resume"]);
+    assert!(!board.halted);
+    d
+}
+
+#[test]
+fn a_silent_board_says_where_its_core_waits() {
+    // HSEON set, HSERDY clear (RM0440 §7.4.1): waiting for the crystal, in rcc::init.
+    let d = diagnose_at(0x0800_1084, Some(1 << 16 | 0x0000_0500));
+    assert_eq!(d.cause, Cause::HseNotStarting);
+    assert_eq!(d.symbol.as_deref(), Some("embassy_stm32::rcc::init"));
+    let t = d.text();
+    assert!(
+        t.contains("no crystal") && t.contains("X3") && t.contains("SB"),
+        "{t}"
+    );
+    // The same wait inlined into main: the register decides.
+    let d = diagnose_at(0x0800_4010, Some(1 << 16));
+    assert_eq!(d.cause, Cause::HseNotStarting);
+    // HSE ready (HSERDY set): main is just main.
+    let d = diagnose_at(0x0800_4010, Some(3 << 16));
+    assert_eq!(d.cause, Cause::Elsewhere);
+    assert!(d.text().contains("kapitza_firmware::main"), "{}", d.text());
+    // Handlers.
+    let d = diagnose_at(0x0800_2004, Some(3 << 16));
+    assert_eq!(d.cause, Cause::HardFault);
+    assert!(d.text().contains("HardFault handler"));
+    let d = diagnose_at(0x0800_3000, Some(3 << 16));
+    assert_eq!(d.cause, Cause::Panic);
+    assert!(d.text().contains("panicked"));
+    // One past the end of main's 0x100 bytes: in no function.
+    let d = diagnose_at(0x0800_4100, Some(3 << 16));
+    assert_eq!((d.cause, d.symbol), (Cause::Unknown, None));
+    // RCC_CR unreadable: the symbol alone points at the clock set-up.
+    let d = diagnose_at(0x0800_1000, None);
+    assert_eq!(d.cause, Cause::HseNotStarting);
+}
+
+#[test]
+fn demangling() {
+    assert_eq!(
+        diagnose::demangle("_ZN4core9panicking5panic17h0123456789abcdefE"),
+        "core::panicking::panic"
+    );
+    assert_eq!(diagnose::demangle("HardFault"), "HardFault");
+    assert_eq!(diagnose::demangle("_ZN3bad"), "_ZN3bad");
+}
+
+#[test]
+fn the_data_folder_follows_xdg() {
+    use std::ffi::OsString;
+    let s = |v: &str| Some(OsString::from(v));
+    if cfg!(any(windows, target_os = "macos")) {
+        return;
+    }
+    // XDG Base Directory Specification: $XDG_DATA_HOME if set and absolute, else
+    // $HOME/.local/share.
+    assert_eq!(
+        backup::data_dir(s("/d"), s("/h"), None),
+        Some(PathBuf::from("/d"))
+    );
+    assert_eq!(
+        backup::data_dir(s("rel"), s("/h"), None),
+        Some(PathBuf::from("/h/.local/share"))
+    );
+    assert_eq!(
+        backup::data_dir(None, s("/h"), None),
+        Some(PathBuf::from("/h/.local/share"))
+    );
+    assert_eq!(backup::data_dir(s(""), None, None), None);
+}
+
+#[test]
+fn dry_run_says_what_it_would_back_up_and_erase() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write_temp(&dir, "fw.elf", &good_image());
+    let data = dir.path().join("data");
+    let env = [("XDG_DATA_HOME", data.to_str().unwrap())];
+    let run = |args: &[&str]| {
+        KAPITZA
+            .run_within(args, &env, None, Duration::from_secs(60))
+            .expect("kapitza flash --dry-run ends")
+    };
+    let o = run(&["flash", &path, "--dry-run", "--erase-config"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    let a = config_area();
+    let want = format!("{:#010x}..{:#010x} ({} bytes)", a.start, a.end, a.len());
+    assert!(text.contains(&want), "{text}");
+    assert!(
+        text.contains(&data.join("kapitza/backups").display().to_string()),
+        "{text}"
+    );
+    assert!(text.contains("would erase it after the backup"), "{text}");
+    // Nothing is created by a dry run.
+    assert!(!data.exists());
+
+    let o = run(&["flash", &path, "--dry-run", "--json"]);
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["erase_config"], false);
+    assert_eq!(
+        v["backup_dir"].as_str(),
+        data.join("kapitza/backups").to_str()
+    );
 }

@@ -60,7 +60,7 @@ pub fn confirm(path: &str, wait: Duration) -> Result<Session> {
             return Err(Failure::new(
                 Exit::NoRig,
                 format!(
-                    "flashed, but the firmware did not answer on {path} within {} s ({why}). Is \
+                    "flashed, but the firmware {SILENT} on {path} within {} s ({why}). Is \
                      that the board's port? Press its reset button and try `kapitza status \
                      --port {path}`",
                     wait.as_secs()
@@ -72,6 +72,16 @@ pub fn confirm(path: &str, wait: Duration) -> Result<Session> {
     }
     let target = Target::Serial { path: path.into() };
     session::open(&target, &SimOptions::new(RigFile::demo(), 1.0))
+}
+
+/// In the message of a board that stayed silent ([`is_silent`]).
+const SILENT: &str = "did not answer";
+
+/// Whether `e` is [`confirm`]'s timeout: the board never answered (as opposed to answering
+/// with another protocol, or no port).
+pub fn is_silent(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<Failure>()
+        .is_some_and(|f| f.exit == Exit::NoRig && f.message.contains(SILENT))
 }
 
 const MISMATCH: &str = "after flashing: the image written is not the firmware of this host tool \

@@ -1,6 +1,6 @@
-//! Writing the image through the probe: attach, confirm the chip's device ID, erase, program
-//! and verify with a progress bar, then reset (unless asked not to). Only the pages the image
-//! covers are erased, never the whole chip, so the configuration page keeps its record.
+//! Writing the image through the probe: confirm the chip's device ID, erase, program and
+//! verify with a progress bar, then reset (unless asked not to). Only the pages the image
+//! covers are erased, never the whole chip, so the configuration area keeps its record.
 
 use std::path::Path;
 
@@ -10,65 +10,35 @@ use probe_rs::flashing::{
     download_file_with_options, DownloadOptions, ElfLoader, ElfOptions, FlashProgress,
     ProgressEvent, ProgressOperation,
 };
-use probe_rs::probe::DebugProbeInfo;
-use probe_rs::{MemoryInterface, Permissions};
+use probe_rs::MemoryInterface;
 
+use super::board::ProbeBoard;
 use super::chip::{self, DBGMCU_IDCODE};
-use super::probes::permission_denied;
-use crate::rig::{Exit, Failure};
 
-/// Flashes `elf` onto `chip` through the probe `info` names, verifies it, and resets the core
-/// unless `reset` is false (then the new image runs from the next reset).
-pub fn program(info: &DebugProbeInfo, chip: &str, elf: &Path, reset: bool) -> Result<()> {
-    let probe = info.open().map_err(|e| {
-        if denied(&e) {
-            permission_denied(info)
-        } else {
-            Failure::new(
-                Exit::NoRig,
-                format!("cannot open the debug probe {}: {e}", info.identifier),
-            )
-            .into()
-        }
-    })?;
-    let mut session = probe.attach(chip, Permissions::default()).map_err(|e| {
-        Failure::new(
-            Exit::NoRig,
-            format!(
-                "cannot attach to {chip} through {}: {e}. Is the board powered, and is its chip \
-                 {chip} (--chip)?",
-                info.identifier
-            ),
-        )
-    })?;
-    let idcode = session.core(0)?.read_word_32(DBGMCU_IDCODE)?;
-    chip::check_dev_id(chip, idcode)?;
-
+/// Flashes `elf` onto the attached board, verifies it, and resets the core unless `reset` is
+/// false (then the new image runs from the next reset).
+pub fn program(board: &mut ProbeBoard, elf: &Path, reset: bool) -> Result<()> {
     let mut bars = Bars::new();
     let mut options = DownloadOptions::default();
     options.verify = true;
     options.progress = FlashProgress::new(|e| bars.event(&e));
-    download_file_with_options(&mut session, elf, ElfLoader(ElfOptions::default()), options)
-        .map_err(|e| anyhow::anyhow!("flashing failed: {e}"))?;
+    download_file_with_options(
+        &mut board.session,
+        elf,
+        ElfLoader(ElfOptions::default()),
+        options,
+    )
+    .map_err(|e| anyhow::anyhow!("flashing failed: {e}"))?;
     if reset {
-        session.core(0)?.reset()?;
+        board.session.core(0)?.reset()?;
     }
     Ok(())
 }
 
-/// Whether an open error comes down to the OS refusing access to the USB device.
-fn denied(e: &(dyn std::error::Error + 'static)) -> bool {
-    let mut cur = Some(e);
-    while let Some(err) = cur {
-        if err
-            .downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::PermissionDenied)
-        {
-            return true;
-        }
-        cur = err.source();
-    }
-    false
+/// Refuses a board whose device ID is not `chip`'s.
+pub fn check_chip(board: &mut ProbeBoard, chip: &str) -> Result<()> {
+    let idcode = board.session.core(0)?.read_word_32(DBGMCU_IDCODE)?;
+    chip::check_dev_id(chip, idcode)
 }
 
 /// One progress bar per flashing step (erase, program, verify), on stderr.
@@ -146,7 +116,7 @@ fn name(op: ProgressOperation) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::super::board::denied;
     use probe_rs::probe::{DebugProbeError, ProbeCreationError};
     use std::io::{Error, ErrorKind};
 
