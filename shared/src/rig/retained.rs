@@ -11,6 +11,7 @@
 //! software reset it holds the record as last written. Its contents are advice, never trusted
 //! blindly: θd is range-checked again ([`super::servo::power_up_deg`]).
 
+use super::bridge::Line;
 use super::safety::Fault;
 use crate::checksum::CRC;
 
@@ -24,7 +25,7 @@ pub struct Retained {
     pub last_fault: Option<Fault>,
 }
 
-const FAULTS: [Fault; 7] = [
+const FAULTS: [Fault; 10] = [
     Fault::EStop,
     Fault::OverCurrent,
     Fault::Stall,
@@ -32,6 +33,9 @@ const FAULTS: [Fault; 7] = [
     Fault::WrongDirection,
     Fault::PhaseLockLost,
     Fault::OverCurrentRms,
+    Fault::DutyCeiling,
+    Fault::Bridge(Line::NFault),
+    Fault::Bridge(Line::Break),
 ];
 
 fn crc(words: &[u32; 3]) -> u32 {
@@ -74,7 +78,14 @@ mod tests {
 
     #[test]
     fn round_trip_and_noise_refused() {
-        for f in [None, Some(Fault::Stall), Some(Fault::WrongDirection)] {
+        for f in [
+            None,
+            Some(Fault::Stall),
+            Some(Fault::WrongDirection),
+            Some(Fault::DutyCeiling),
+            Some(Fault::Bridge(Line::NFault)),
+            Some(Fault::Bridge(Line::Break)),
+        ] {
             let r = Retained {
                 theta_d_deg: 123.5,
                 last_fault: f,
