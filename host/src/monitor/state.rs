@@ -14,7 +14,7 @@ use kapitza_core::rig::config::RigConfig;
 
 use super::feed::{Command, Event};
 use crate::rig::live::Live;
-use crate::rig::names::{fault_hint, fault_name, fault_reason, mode_name};
+use crate::rig::names::{fault_name, fault_reason, mode_name};
 use crate::rig::predicted::predict;
 
 /// Seconds of slow angle the chart keeps.
@@ -252,7 +252,7 @@ impl State {
         if self.mode != Some(m) {
             let fault = mode_fault(m).map_or(String::new(), |f| {
                 let line = fault_reason(&f).map_or(String::new(), |r| format!(", {r}"));
-                format!(" ({}{line}: {})", fault_name(&f), fault_hint(&f))
+                format!(" ({}{line})", fault_name(&f))
             });
             self.note(format!("mode: {}{fault}", mode_name(&m)));
             self.mode = Some(m);
