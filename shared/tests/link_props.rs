@@ -4,8 +4,9 @@
 
 use kapitza_core::link::frame::{encode, open, receive_request, receive_response, Header};
 use kapitza_core::link::message::{
-    Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
-    StopReason, Telemetry, Verdict, WireCalibration, WireClosedLoop, WireConfig, WireGeometry,
+    BridgeLine, Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo,
+    SensorDiagnostics, StopReason, Telemetry, Verdict, WireCalibration, WireClosedLoop, WireConfig,
+    WireGeometry,
 };
 use kapitza_core::link::origin::FieldSet;
 use kapitza_core::link::reason::ConfigField;
@@ -24,7 +25,9 @@ fn fault() -> impl Strategy<Value = Fault> {
         Just(Fault::WrongDirection),
         Just(Fault::PhaseLockLost),
         Just(Fault::OverCurrentRms),
-        Just(Fault::DutyCeiling)
+        Just(Fault::DutyCeiling),
+        Just(Fault::Bridge(BridgeLine::NFault)),
+        Just(Fault::Bridge(BridgeLine::Break))
     ]
 }
 
@@ -212,6 +215,7 @@ fn reason() -> impl Strategy<Value = Reason> {
         Just(Reason::CheckRunning),
         (any::<i16>(), any::<i16>())
             .prop_map(|(requested, cap)| Reason::DutyAboveCap { requested, cap }),
+        Just(Reason::BridgeFaultActive),
     ]
 }
 

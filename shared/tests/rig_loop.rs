@@ -8,6 +8,7 @@ use kapitza_core::link::message::{Check, Fault, Mode};
 use kapitza_core::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 use kapitza_core::persist::ConfigOrigin;
 use kapitza_core::rig::as5047::Diagnostics;
+use kapitza_core::rig::bridge::Lines;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::{Angle, Duty};
 use kapitza_core::station::drive::Drive;
@@ -32,6 +33,11 @@ impl Drive for Follow {
     fn set_duty(&mut self, d: Duty) {
         self.duty = d.to_num();
     }
+    /// A healthy bridge: nFAULT high, no break (tests/rig_bridge.rs breaks it).
+    fn bridge_lines(&mut self) -> Lines {
+        Lines::default()
+    }
+    fn rearm(&mut self) {}
 }
 
 struct Bench {

@@ -97,6 +97,9 @@ proptest! {
                             duty_saturated: false,
                             ramping: false,
                             link_us: t,
+                            nfault_low: false,
+                            bridge: None,
+                            sensor_not_ready: false,
                         };
                         let out = sup.check(t, &inp);
                         if out.halt { dds.halt() } else { dds.set_target(out.target_word) }
@@ -146,6 +149,9 @@ fn quiet(ref_omega: f64, crank: f64, stopped: bool) -> Inputs {
         duty_saturated: false,
         ramping: false,
         link_us: 0,
+        nfault_low: false,
+        bridge: None,
+        sensor_not_ready: false,
     }
 }
 
@@ -442,4 +448,60 @@ fn a_drive_held_at_the_duty_ceiling_faults_after_the_stall_debounce() {
         check(&mut s, t, &at_ceiling);
     }
     assert_eq!(s.mode(), Mode::Idle);
+}
+
+#[test]
+fn a_bridge_fault_latches_and_its_clear_waits_for_nfault() {
+    use kapitza_core::rig::bridge::Line;
+    let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
+    s.request(Request::Start { omega: 100.0 }).unwrap();
+    let run = quiet(100.0, 100.0, false);
+    let out = check(&mut s, 1000, &run);
+    assert!(out.active && !out.halt);
+    // The tick that is told of it latches it and halts the drive.
+    let seen = Inputs {
+        nfault_low: true,
+        bridge: Some(Line::NFault),
+        ..run
+    };
+    let out = check(&mut s, 2000, &seen);
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Bridge(Line::NFault)));
+    assert!(out.halt && !out.active);
+    // nFAULT still low: refused, nothing changed.
+    let low = Inputs {
+        nfault_low: true,
+        ..quiet(0.0, 0.0, true)
+    };
+    check(&mut s, 3000, &low);
+    let before = s;
+    assert_eq!(
+        s.request(Request::ClearFault),
+        Err(Refusal::BridgeFaultActive)
+    );
+    assert_eq!(s, before);
+    // High again: cleared.
+    check(&mut s, 4000, &quiet(0.0, 0.0, true));
+    assert_eq!(s.request(Request::ClearFault), Ok(()));
+    assert_eq!(s.mode(), Mode::Idle);
+}
+
+#[test]
+fn a_sensor_not_ready_is_a_fault_only_while_driving() {
+    let mut s = Supervisor::new(&RigConfig::REFERENCE, Angle::ZERO, 0);
+    let unready = |i: Inputs| Inputs {
+        sensor_not_ready: true,
+        ..i
+    };
+    // Idle for a second: no fault (the pre-run check refuses the start instead).
+    for k in 1..=1000 {
+        check(&mut s, k * 1000, &unready(quiet(0.0, 0.0, true)));
+    }
+    assert_eq!(s.mode(), Mode::Idle);
+    s.request(Request::Start { omega: 100.0 }).unwrap();
+    s.heard_from_link(1_001_000);
+    check(&mut s, 1_001_000, &quiet(100.0, 100.0, false));
+    assert_eq!(s.mode(), Mode::Running);
+    // Running: the first tick that is told of it latches it.
+    check(&mut s, 1_002_000, &unready(quiet(100.0, 100.0, false)));
+    assert_eq!(s.mode(), Mode::Faulted(Fault::Sensor));
 }

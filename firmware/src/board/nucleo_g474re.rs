@@ -185,6 +185,24 @@ impl Drive {
         self.adc
             .blocking_read(&mut self.sense, SampleTime::CYCLES24_5)
     }
+    /// nFAULT (PA6) reads low. GPIOA_IDR follows the pin in its alternate function too.
+    pub fn nfault_low(&self) -> bool {
+        pac::GPIOA.idr().read().idr(6) == pac::gpio::vals::Idr::LOW
+    }
+    /// TIM1_SR.BIF: the break input (nFAULT) cut the outputs since the flag was last cleared.
+    pub fn break_flag(&self) -> bool {
+        pac::TIM1.sr().read().bif(0)
+    }
+    /// Clears BIF and sets MOE again: the outputs follow the PWM. While nFAULT is low the break
+    /// input keeps MOE cleared and BIF set; the rig loop asks only while it reads high.
+    pub fn rearm(&mut self) {
+        // SR's flags are cleared by writing 0 (rc_w0) and kept by writing 1: one write clears
+        // BIF alone, without a read-modify-write racing the other flags.
+        let mut sr = pac::timer::regs::SrAdv(u32::MAX);
+        sr.set_bif(0, false);
+        pac::TIM1.sr().write_value(sr);
+        pac::TIM1.bdtr().modify(|w| w.set_moe(true));
+    }
 }
 
 /// The tilt servo's PWM.
@@ -228,8 +246,9 @@ impl PendulumBus {
 /// TIM1's break input on PA6 (AF6), wired to the DRV8874's nFAULT: a bridge fault (over-current,
 /// over-temperature, under-voltage) clears MOE in hardware within a few clock cycles, forcing the
 /// PWM pin to its idle level (low) whatever the software does. Active low, filtered over 8 clock
-/// samples (47 ns) against glitches; no automatic re-enable (AOE = 0): only a reset re-arms the
-/// drive. The pin is taken from `Peripherals` so nothing else can claim it.
+/// samples (47 ns) against glitches; no automatic re-enable (AOE = 0): the rig loop reads BIF and
+/// the pin at every control tick and re-arms through [`Drive::rearm`] (`kapitza_core::rig::bridge`).
+/// The pin is taken from `Peripherals` so nothing else can claim it.
 fn arm_break_input(_nfault: Peri<'static, PA6>) {
     let pa = pac::GPIOA;
     pa.pupdr()

@@ -7,7 +7,8 @@
 //! ```text
 //! every sample (from the pendulum task):  loop.sample
 //! when it says a control tick is due:     bytes from the link task → loop.receive (answered now)
-//!                                         loop.control(encoder, ADC counts, e-stop pin) → duty
+//!                                         loop.control(encoder, ADC counts, nFAULT and TIM1's
+//!                                         BIF, e-stop pin) → duty, a re-arm (BIF, MOE)
 //!                                         bridge enable, servo pulse, a configuration to
 //!                                         store, heartbeat to the watchdog, θd and the last
 //!                                         fault to the retained RAM
@@ -18,6 +19,7 @@
 
 use kapitza_core::link::message::ResetInfo;
 use kapitza_core::persist::ConfigOrigin;
+use kapitza_core::rig::bridge::Lines;
 use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::fixed::{Angle, Duty};
 use kapitza_core::rig::retained::Retained;
@@ -64,6 +66,15 @@ impl kapitza_core::station::drive::Drive for Hw<'_> {
     }
     fn set_duty(&mut self, duty: Duty) {
         self.drive.set_duty(duty.to_bits());
+    }
+    fn bridge_lines(&mut self) -> Lines {
+        Lines {
+            nfault_low: self.drive.nfault_low(),
+            break_flag: self.drive.break_flag(),
+        }
+    }
+    fn rearm(&mut self) {
+        self.drive.rearm();
     }
 }
 

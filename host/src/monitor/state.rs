@@ -14,7 +14,7 @@ use kapitza_core::rig::config::RigConfig;
 
 use super::feed::{Command, Event};
 use crate::rig::live::Live;
-use crate::rig::names::{fault_name, mode_name};
+use crate::rig::names::{fault_name, fault_reason, mode_name};
 use crate::rig::predicted::predict;
 
 /// Seconds of slow angle the chart keeps.
@@ -250,7 +250,10 @@ impl State {
 
     fn set_mode(&mut self, m: Mode) {
         if self.mode != Some(m) {
-            let fault = mode_fault(m).map_or(String::new(), |f| format!(" ({})", fault_name(&f)));
+            let fault = mode_fault(m).map_or(String::new(), |f| {
+                let line = fault_reason(&f).map_or(String::new(), |r| format!(", {r}"));
+                format!(" ({}{line})", fault_name(&f))
+            });
             self.note(format!("mode: {}{fault}", mode_name(&m)));
             self.mode = Some(m);
         }

@@ -13,7 +13,7 @@ use kapitza_core::rig::config::RigConfig;
 use serde::Serialize;
 
 use super::live::Live;
-use super::names::{fault_name, mode_name, reset_name, stop_name};
+use super::names::{fault_hint, fault_name, fault_reason, mode_name, reset_name, stop_name};
 use super::owner;
 use super::port::{self, ReadWrite, Target};
 use super::predicted::{predict, Prediction};
@@ -165,8 +165,12 @@ impl Session {
 pub struct StatusView {
     /// `"idle"`, `"running"`, `"stopping"`, `"faulted"`.
     pub mode: &'static str,
-    /// The latched fault (`"estop"`, `"over_current"`, `"stall"`), or null.
+    /// The latched fault (`"estop"`, `"over_current"`, `"stall"`, `"bridge"`, …), or null.
     pub fault: Option<&'static str>,
+    /// The line a bridge fault was seen on (`"nfault"`, `"break"`), or null.
+    pub fault_reason: Option<&'static str>,
+    /// What to do about the latched fault, or null.
+    pub fault_hint: Option<&'static str>,
     /// Why the drive last stopped, or null.
     pub last_stop: Option<&'static str>,
     pub estop: bool,
@@ -243,6 +247,14 @@ impl StatusView {
                 Mode::Faulted(f) => Some(fault_name(&f)),
                 _ => None,
             },
+            fault_reason: match s.mode {
+                Mode::Faulted(f) => fault_reason(&f),
+                _ => None,
+            },
+            fault_hint: match s.mode {
+                Mode::Faulted(f) => Some(fault_hint(&f)),
+                _ => None,
+            },
             last_stop: s.last_stop.as_ref().map(stop_name),
             estop: s.estop,
             r_target,
@@ -298,7 +310,13 @@ impl StatusView {
     pub fn text(&self) -> String {
         let mut s = format!("mode        {}", self.mode);
         if let Some(f) = self.fault {
-            s += &format!(" (fault: {f}; `kapitza clear` once its cause is gone)");
+            let line = self
+                .fault_reason
+                .map_or(String::new(), |r| format!(", {r}"));
+            let hint = self
+                .fault_hint
+                .unwrap_or("`kapitza clear` once its cause is gone");
+            s += &format!(" (fault: {f}{line}; {hint})");
         } else if let Some(r) = self.last_stop {
             s += &format!(" (last stop: {r})");
         }

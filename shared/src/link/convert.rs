@@ -2,7 +2,8 @@
 //! and the I16F16 / degree conversions at the boundary.
 
 use super::message::{
-    Fault, Mode, RMethod, ResetCause, ResetInfo, SensorDiagnostics, StopReason, WireCalibration,
+    BridgeLine, Fault, Mode, RMethod, ResetCause, ResetInfo, SensorDiagnostics, StopReason,
+    WireCalibration,
     WireClosedLoop, WireConfig, WireGeometry, Q16,
 };
 use super::reason::{ConfigField, Reason};
@@ -51,6 +52,16 @@ impl From<safety::Fault> for Fault {
             safety::Fault::PhaseLockLost => Self::PhaseLockLost,
             safety::Fault::OverCurrentRms => Self::OverCurrentRms,
             safety::Fault::DutyCeiling => Self::DutyCeiling,
+            safety::Fault::Bridge(l) => Self::Bridge(l.into()),
+        }
+    }
+}
+
+impl From<crate::rig::bridge::Line> for BridgeLine {
+    fn from(l: crate::rig::bridge::Line) -> Self {
+        match l {
+            crate::rig::bridge::Line::NFault => Self::NFault,
+            crate::rig::bridge::Line::Break => Self::Break,
         }
     }
 }
@@ -133,6 +144,7 @@ impl From<safety::Refusal> for Reason {
             R::Faulted(f) => Self::Faulted(f.into()),
             R::WrongMode(m) => Self::WrongMode(m.into()),
             R::EStopStillActive => Self::EStopStillActive,
+            R::BridgeFaultActive => Self::BridgeFaultActive,
         }
     }
 }

@@ -352,6 +352,18 @@ pub enum Fault {
     PhaseLockLost,
     OverCurrentRms,
     DutyCeiling,
+    /// The H-bridge signalled a fault while awake, on this line.
+    Bridge(BridgeLine),
+}
+
+/// [`crate::rig::bridge::Line`]: which line showed a bridge fault.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, MaxSize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BridgeLine {
+    /// nFAULT read low.
+    NFault,
+    /// TIM1's break flag was set, nFAULT high again.
+    Break,
 }
 
 /// [`crate::model::RMethod`].

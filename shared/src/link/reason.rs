@@ -58,6 +58,8 @@ pub enum Reason {
     CheckRunning,
     /// A bring-up duty (I1F15) above the bring-up cap.
     DutyAboveCap { requested: Q15, cap: Q15 },
+    /// `ClearFault` while the H-bridge's nFAULT still reads low.
+    BridgeFaultActive,
 }
 
 /// The configuration field a [`Reason::ConfigInvalid`] names.
@@ -259,6 +261,7 @@ impl Reason {
             Self::ConfigInvalid { .. } => 23,
             Self::CheckRunning => 24,
             Self::DutyAboveCap { .. } => 25,
+            Self::BridgeFaultActive => 26,
         }
     }
 
@@ -320,6 +323,9 @@ impl fmt::Display for Reason {
                 f64::from(requested) / 32_768.0,
                 f64::from(cap) / 32_768.0
             ),
+            Self::BridgeFaultActive => {
+                f.write_str("the H-bridge still signals a fault (nFAULT low): check its supply")
+            }
         }
     }
 }

@@ -94,7 +94,10 @@ pub struct Diagnostics {
     pub magnet_high: bool,
     /// CORDIC overflow: the angle is invalid.
     pub cordic_overflow: bool,
-    /// Offset compensation finished (the sensor is ready).
+    /// Offset compensation finished (the sensor is ready). A sensor that was ready does not
+    /// lose it; a MISO line stuck low does (every frame 0x0000 passes parity and the error
+    /// flag and reads as DIAAGC 0: AGC 0, LF clear, magnet "ok"), so a loss while the drive
+    /// runs is a sensor fault ([`super::safety`]).
     pub ready: bool,
 }
 

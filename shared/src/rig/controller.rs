@@ -3,13 +3,14 @@
 //!
 //! ```text
 //! sample tick (fs):   φ_ref ← DDS tick;  estimator ← (t, θ_pendulum, φ_ref)
-//! control tick (fc):  motor → (crank angle, current);  safety.check → run / ramp / halt, θd;
+//! control tick (fc):  motor → (crank angle, current), bridge lines;  safety.check → run / ramp / halt, θd;
 //!                     DDS target or halt (a start aligns the DDS phase to the crank);
 //!                     phase lock → duty → motor;  estimator restarts its slow history while
 //!                     the drive ramps or θd slews;  closed-loop R (when on) trims ω once the
 //!                     pendulum has settled ([`super::r_trim`])
 //! ```
 
+use super::bridge::Line;
 use super::closed_loop::ClosedLoopR;
 use super::config::RigConfig;
 use super::dds::Dds;
@@ -42,6 +43,9 @@ pub struct Rig {
     est: Estimator,
     sup: Supervisor,
     sensor_failed: bool,
+    sensor_not_ready: bool,
+    nfault_low: bool,
+    bridge: Option<Line>,
     phase_error: RadPerSec,
     saturated: bool,
     trim: RTrim,
@@ -57,6 +61,9 @@ impl Rig {
             est: Estimator::new(cfg, tuning, theta_d0),
             sup: Supervisor::new(cfg, theta_d0, now_us),
             sensor_failed: false,
+            sensor_not_ready: false,
+            nfault_low: false,
+            bridge: None,
             phase_error: RadPerSec::ZERO,
             saturated: false,
             trim: RTrim::new(
@@ -104,6 +111,20 @@ impl Rig {
         self.sensor_failed = failed;
     }
 
+    /// The pendulum sensor's last diagnostics say it is not ready
+    /// ([`super::as5047::Diagnostics::ready`] clear): the next control tick latches
+    /// [`super::safety::Fault::Sensor`] if the drive runs.
+    pub fn sensor_not_ready(&mut self, not_ready: bool) {
+        self.sensor_not_ready = not_ready;
+    }
+
+    /// The H-bridge's lines for the next control tick: nFAULT's level, and the fault they show
+    /// ([`super::bridge::Watch::check`]), latched as [`super::safety::Fault::Bridge`].
+    pub fn bridge(&mut self, nfault_low: bool, fault: Option<Line>) {
+        self.nfault_low = nfault_low;
+        self.bridge = fault;
+    }
+
     /// Sample tick: advance the reference phase and feed the estimator. Returns the phase.
     #[inline]
     pub fn sample(&mut self, t_us: u32, pendulum: Angle) -> Angle {
@@ -137,6 +158,9 @@ impl Rig {
             duty_saturated: self.saturated,
             ramping: self.dds.is_ramping(),
             link_us,
+            nfault_low: self.nfault_low,
+            bridge: self.bridge.take(),
+            sensor_not_ready: self.sensor_not_ready,
         };
         let out = self.sup.check(t_us, &inputs);
         if out.halt {

@@ -16,6 +16,7 @@
 //! | [`phase_lock`] | the [`phase_lock::Motor`] trait and the crank phase-lock controller (feed-forward + PI on the phase error) |
 //! | [`estimator`] | slow angle by synchronous averaging, slow frequency and decay, settled flag, R in situ, fast-wobble check of A |
 //! | [`as5047`] | the pendulum sensor's SPI frames: parity, the error flag and its clearing read, diagnostics (magnet), health |
+//! | [`bridge`] | the H-bridge's nFAULT and TIM1's break flag: ignored while it sleeps and wakes, a latched fault once awake |
 //! | [`estop`] | the e-stop line debounced at the control tick; unknown counts as pressed |
 //! | [`safety`] | limits, refusals with reasons, stall / over-current / e-stop faults, the link-silence policy |
 //! | [`r_trim`] | closed-loop R: once settled, ω trimmed so the in-situ R equals the R asked for, within a band and a rate limit |
@@ -36,6 +37,7 @@
 //! Costs per update and the 20 % budget at 170 MHz are measured in `docs/accuracy-mcu.md`.
 
 pub mod as5047;
+pub mod bridge;
 pub mod calibration;
 pub mod closed_loop;
 pub mod config;

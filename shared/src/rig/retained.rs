@@ -20,6 +20,7 @@
 //! a watchdog or software reset it holds the records as last written. Their contents are
 //! advice, never trusted blindly: θd is range-checked again ([`super::servo::power_up_deg`]).
 
+use super::bridge::Line;
 use super::safety::Fault;
 use crate::checksum::CRC;
 
@@ -36,7 +37,7 @@ pub struct Retained {
 }
 
 /// Every fault, in the order of their retained numbers (append only: the numbers are stored).
-const FAULTS: [Fault; 8] = [
+const FAULTS: [Fault; 10] = [
     Fault::EStop,
     Fault::OverCurrent,
     Fault::Stall,
@@ -45,6 +46,8 @@ const FAULTS: [Fault; 8] = [
     Fault::PhaseLockLost,
     Fault::OverCurrentRms,
     Fault::DutyCeiling,
+    Fault::Bridge(Line::NFault),
+    Fault::Bridge(Line::Break),
 ];
 
 fn crc(words: &[u32; 3]) -> u32 {

@@ -10,10 +10,11 @@
 //!            Start(ω ≤ ω_max)                Stop, or link silent > timeout
 //!   Idle ───────────────────────▶ Running ───────────────────────────────▶ Stopping ─▶ Idle
 //!    ▲                               │  SetOmega (ramped), SetDriveAngle (slewed)      (when the
-//!    │ ClearFault (e-stop released)  │                                                  drive is 0)
+//!    │ ClearFault (e-stop released,  │                                                  drive is 0)
+//!    │  nFAULT high)                 │
 //!    └──────────── Faulted ◀─────────┴── e-stop, over-current (peak, RMS), stall, wrong direction,
-//!                                        sensor, phase lock lost, duty ceiling (from any state): drive halted
-//!                                        at once, duty 0, latched
+//!                                        sensor, phase lock lost, duty ceiling, bridge (from any
+//!                                        state): drive halted at once, duty 0, latched
 //! ```
 //! A drive strength R from the laptop becomes ω = ωc√R through [`RigConfig::omega_for_r`]
 //! before it reaches the supervisor (physics §7: "setting R means computing ω from R, A and ℓ").
@@ -22,7 +23,9 @@
 //! outside). Over-current: I > I_max for `overcurrent_ms`. Stall: commanded ω ≥ `stall_min_omega`
 //! and crank speed < `stall_fraction`·commanded for `stall_ms`. Wrong direction: the same
 //! commanded speed while the crank turns backwards faster than `stall_fraction`·commanded for
-//! `stall_ms`. Sensor: the pendulum sensor's driver reports it failed. Phase lock lost: two
+//! `stall_ms`. Sensor: the pendulum sensor's driver reports it failed, or, while the drive runs,
+//! its diagnostics say it is not ready. Bridge: the H-bridge's nFAULT or TIM1's break while the
+//! bridge is awake ([`super::bridge`]). Phase lock lost: two
 //! cycle slips within [`SLIP_WINDOW_US`]. Over-current RMS (I²t): the exponential mean of i²
 //! over [`RMS_TAU_S`] above ([`RMS_FRACTION`]·I_max)². Duty ceiling: the phase lock clamped at
 //! `duty_max` for `stall_ms` while driving.
@@ -37,6 +40,7 @@
 //! sees `Idle` and the reason, and must send `Start` again. Silence while `Idle`, `Stopping` or
 //! `Faulted` changes nothing.
 
+use super::bridge::Line;
 use super::config::RigConfig;
 use super::dds::word_from_omega;
 use super::fixed::{elapsed_us, Amps, Angle, RadPerSec};
@@ -78,6 +82,9 @@ pub enum Refusal {
     WrongMode(Mode),
     /// `ClearFault` while the e-stop line is still active.
     EStopStillActive,
+    /// `ClearFault` while the H-bridge's nFAULT still reads low: re-enabling the outputs
+    /// would only trip the break again.
+    BridgeFaultActive,
 }
 
 impl core::fmt::Display for Refusal {
@@ -103,6 +110,9 @@ impl core::fmt::Display for Refusal {
             Self::Faulted(x) => write!(f, "a fault is latched ({x:?}): clear it first"),
             Self::WrongMode(m) => write!(f, "not allowed in mode {m:?}"),
             Self::EStopStillActive => f.write_str("the emergency stop is still pressed"),
+            Self::BridgeFaultActive => {
+                f.write_str("the H-bridge still signals a fault (nFAULT low)")
+            }
         }
     }
 }
@@ -131,6 +141,9 @@ pub enum Fault {
     /// The drive has needed the duty ceiling (`duty_max`) for `stall_ms`: the motor cannot
     /// hold the asked-for speed within the duty it may use.
     DutyCeiling,
+    /// The H-bridge signalled a fault while awake ([`super::bridge`]): its outputs are off
+    /// (TIM1's break) until `ClearFault` re-arms them.
+    Bridge(Line),
 }
 
 /// Two cycle slips within this long lose the lock (µs).
@@ -180,6 +193,13 @@ pub struct Inputs {
     /// On the rig it is `now_us`; a simulated rig running faster than real time gives wall time,
     /// so the link-silence timeout stays what it says.
     pub link_us: u32,
+    /// The H-bridge's nFAULT reads low now (asleep or not): `ClearFault` waits for it.
+    pub nfault_low: bool,
+    /// A bridge fault seen this tick ([`super::bridge::Watch::check`]).
+    pub bridge: Option<Line>,
+    /// The pendulum sensor's last diagnostics say it is not ready
+    /// ([`super::as5047::Diagnostics::ready`] clear): a sensor fault while the drive runs.
+    pub sensor_not_ready: bool,
 }
 
 /// What the drive may do after this tick.
@@ -215,6 +235,7 @@ pub struct Supervisor {
     i2_weight: f32,
     i2_max: f32,
     estop_seen: bool,
+    nfault_seen: bool,
     // limits, fixed at construction
     omega_max: f64,
     theta_min_deg: f64,
@@ -256,6 +277,7 @@ impl Supervisor {
                 i * i
             },
             estop_seen: false,
+            nfault_seen: false,
             omega_max: l.omega_max,
             theta_min_deg: l.drive_angle_min_deg,
             theta_min: Angle::from_deg(l.drive_angle_min_deg),
@@ -355,6 +377,9 @@ impl Supervisor {
                     if self.estop_seen {
                         return Err(Refusal::EStopStillActive);
                     }
+                    if self.nfault_seen {
+                        return Err(Refusal::BridgeFaultActive);
+                    }
                     self.mode = Mode::Idle;
                     self.over_since = None;
                     self.stall_since = None;
@@ -375,6 +400,7 @@ impl Supervisor {
     /// One control tick: faults, link silence, end of a stop, θd slew.
     pub fn check(&mut self, now_us: u32, inp: &Inputs) -> Output {
         self.estop_seen = inp.estop;
+        self.nfault_seen = inp.nfault_low;
         let mut halt = false;
         if inp.estop {
             if self.mode != Mode::Faulted(Fault::EStop) {
@@ -391,7 +417,18 @@ impl Supervisor {
         } else {
             self.over_since = None;
         }
-        if inp.sensor_failed && !matches!(self.mode, Mode::Faulted(_)) {
+        if let Some(line) = inp.bridge {
+            if !matches!(self.mode, Mode::Faulted(_)) {
+                self.fault(Fault::Bridge(line));
+            }
+        }
+        // A sensor that stops being ready while the drive runs (a MISO line stuck low reads
+        // DIAAGC 0: AGC 0, LF clear) is as failed as a silent one; idle, the pre-run check
+        // refuses the next start for it.
+        let driving_now = matches!(self.mode, Mode::Running | Mode::Stopping(_));
+        if (inp.sensor_failed || (driving_now && inp.sensor_not_ready))
+            && !matches!(self.mode, Mode::Faulted(_))
+        {
             self.fault(Fault::Sensor);
         }
         // I²t: the exponential mean of i² against the RMS limit squared.

@@ -13,7 +13,7 @@ use crate::rig::dds::{word_from_omega, Dds};
 use crate::rig::estimator::{Estimate, Estimator, Tuning};
 use crate::rig::fixed::{approx, trig, Angle, RadPerSec};
 use crate::rig::phase_lock::PhaseLock;
-use crate::rig::safety::{Inputs, Mode, Request, Supervisor};
+use crate::rig::safety::{Fault, Inputs, Mode, Request, Supervisor};
 
 /// FNV-1a, 64-bit (Fowler–Noll–Vo; offset basis and prime from the published parameters).
 #[derive(Debug, Clone, Copy)]
@@ -215,6 +215,9 @@ fn safety_script() -> u64 {
                 duty_saturated: false,
                 ramping: false,
                 link_us: t,
+                nfault_low: false,
+                bridge: None,
+                sensor_not_ready: false,
             };
             let o = s.check(t, &inp);
             d.u32(u32::from(o.active) | (u32::from(o.halt) << 1));
@@ -398,6 +401,9 @@ fn bench_faults() -> u64 {
                 duty_saturated: false,
                 ramping: false,
                 link_us: t,
+                nfault_low: false,
+                bridge: None,
+                sensor_not_ready: false,
             };
             let o = s.check(t, &inp);
             d.u32(u32::from(o.halt));
@@ -405,11 +411,28 @@ fn bench_faults() -> u64 {
                 Mode::Idle => 0,
                 Mode::Running => 1,
                 Mode::Stopping(_) => 2,
-                Mode::Faulted(f) => 10 + f as u32,
+                Mode::Faulted(f) => 10 + fault_index(f),
             });
         }
     }
     d.finish()
+}
+
+/// A fault's number in the digest: its place in [`Fault`]'s declaration.
+fn fault_index(f: Fault) -> u32 {
+    use crate::rig::bridge::Line;
+    match f {
+        Fault::EStop => 0,
+        Fault::OverCurrent => 1,
+        Fault::Stall => 2,
+        Fault::Sensor => 3,
+        Fault::WrongDirection => 4,
+        Fault::PhaseLockLost => 5,
+        Fault::OverCurrentRms => 6,
+        Fault::DutyCeiling => 7,
+        Fault::Bridge(Line::NFault) => 8,
+        Fault::Bridge(Line::Break) => 9,
+    }
 }
 
 /// Every scenario, in order.

@@ -9,17 +9,23 @@ use crate::link::frame::{encode, Header};
 use crate::link::{Request, MAX_REQUEST_FRAME};
 use crate::persist::ConfigOrigin;
 use crate::rig::as5047::Diagnostics;
+use crate::rig::bridge::Lines;
 use crate::rig::config::RigConfig;
 use crate::rig::fixed::{Angle, Duty};
 use crate::station::drive::Drive;
 use crate::station::{RigLoop, Sample};
 
 /// A crank that follows the duty with a first-order lag, in integers (0.9 · 500 rad/s at full
-/// duty, τ = 60 ms, 1 ms steps), and a current sense reading 6/77 of the duty in counts.
+/// duty, τ = 60 ms, 1 ms steps), and a current sense reading 6/77 of the duty in counts; behind
+/// a bridge whose nFAULT the scenario drives, TIM1's break clearing MOE while it is low.
 struct Crank {
     angle: Angle,
     speed_q16: i64,
     duty: i64,
+    nfault_low: bool,
+    bif: bool,
+    moe: bool,
+    rearms: u32,
 }
 
 impl Drive for Crank {
@@ -32,11 +38,44 @@ impl Drive for Crank {
     fn set_duty(&mut self, d: Duty) {
         self.duty = i64::from(d.to_bits());
     }
+    fn bridge_lines(&mut self) -> Lines {
+        Lines {
+            nfault_low: self.nfault_low,
+            break_flag: self.bif,
+        }
+    }
+    fn rearm(&mut self) {
+        self.rearms += 1;
+        self.bif = self.nfault_low;
+        self.moe = !self.nfault_low;
+    }
 }
 
 impl Crank {
+    fn new(angle: Angle) -> Self {
+        Self {
+            angle,
+            speed_q16: 0,
+            duty: 0,
+            nfault_low: false,
+            bif: false,
+            moe: true,
+            rearms: 0,
+        }
+    }
+
+    /// nFAULT as it reads now; the break input acts on it at once.
+    fn nfault(&mut self, low: bool) {
+        self.nfault_low = low;
+        if low {
+            self.bif = true;
+            self.moe = false;
+        }
+    }
+
     fn step(&mut self) {
-        self.speed_q16 += (self.duty * 900 - self.speed_q16) / 60;
+        let duty = if self.moe { self.duty } else { 0 };
+        self.speed_q16 += (duty * 900 - self.speed_q16) / 60;
         self.angle += Angle::from_bits(((self.speed_q16 * 10_430) / 1_000_000) as i32);
     }
 }
@@ -58,11 +97,7 @@ fn rig_loop_conversation() -> u64 {
         0,
         [0, 1, 0],
     );
-    let mut crank = Crank {
-        angle: Angle::from_deg(10.0),
-        speed_q16: 0,
-        duty: 0,
-    };
+    let mut crank = Crank::new(Angle::from_deg(10.0));
     let mut d = Digest::default();
     let mut buf = [0u8; MAX_REQUEST_FRAME];
     let mut out = [0u8; 64];
@@ -126,9 +161,83 @@ fn rig_loop_conversation() -> u64 {
     d.finish()
 }
 
+/// The bridge's fault latch through the rig loop: a drive, nFAULT falling while it runs (latched
+/// at that tick), a clear refused while nFAULT is low, nFAULT high again, the clear taken and the
+/// outputs re-armed, the drive again — 4 s at 10 kHz; the digest covers every byte sent, the
+/// bridge and duty of every tick and the re-arms.
+fn rig_loop_bridge_latch() -> u64 {
+    let mut rig = RigLoop::new(
+        RigConfig::REFERENCE,
+        ConfigOrigin::Stored,
+        Angle::from_deg(0.0),
+        0,
+        [0, 1, 0],
+    );
+    let mut crank = Crank::new(Angle::ZERO);
+    let mut d = Digest::default();
+    let mut buf = [0u8; MAX_REQUEST_FRAME];
+    let mut out = [0u8; 64];
+    let mut t: u32 = 0;
+    let start = Request::SetDrive {
+        r: 2 << 16,
+        theta_d_deg: 0,
+    };
+    for k in 0..40_000u32 {
+        let ms = k / 10;
+        if k % 10 == 0 {
+            match ms {
+                1_500 => crank.nfault(true),
+                1_700 => crank.nfault(false),
+                _ => {}
+            }
+            let req = match ms {
+                10 | 2_000 => Some(start),
+                1_000 | 1_510 | 1_650 | 1_750 | 3_900 => Some(Request::GetStatus),
+                1_600 | 1_800 => Some(Request::ClearFault),
+                _ => None,
+            };
+            if let Some(r) = req {
+                let n = frame((ms % 250) as u8 + 1, &r, &mut buf);
+                rig.receive(&buf[..n], t);
+            }
+        }
+        let due = rig.sample(Sample {
+            t_us: t,
+            count: 100,
+            failed: false,
+            late: false,
+            sensor_failed: false,
+            diagnostics: Some(Diagnostics::HEALTHY),
+        });
+        if due {
+            let tick = rig.control(t, &mut crank, Some(false));
+            d.u32(u32::from(tick.bridge));
+            d.i32(tick.report.duty.to_bits().into());
+            d.u32(crank.rearms);
+            crank.step();
+        }
+        loop {
+            let n = rig.transmit(&mut out);
+            if n == 0 {
+                break;
+            }
+            d.bytes(&out[..n]);
+        }
+        t = t.wrapping_add(100);
+    }
+    d.finish()
+}
+
 /// Every scenario of the rig loop, in order.
-pub const CASES: &[Case] = &[Case {
-    name: "rig_loop_conversation",
-    run: rig_loop_conversation,
-    expected: 0x42bf_1013_2453_b8a5,
-}];
+pub const CASES: &[Case] = &[
+    Case {
+        name: "rig_loop_conversation",
+        run: rig_loop_conversation,
+        expected: 0x2288_21ae_9278_5160,
+    },
+    Case {
+        name: "rig_loop_bridge_latch",
+        run: rig_loop_bridge_latch,
+        expected: 0xaaf5_b80b_021f_b3d2,
+    },
+];

@@ -8,13 +8,15 @@
 //! | [`sensor`] | the pendulum sensor's chip behind its SPI pins (AS5047P), with its faults |
 //! | [`hand`] | a lab hand that lifts and lets go of the pendulum when calibration asks for it |
 //! | [`body`] | the actuator's body: the rod stays within 90° of the blade, a lossy contact |
+//! | [`bridge`] | the H-bridge's supply through the e-stop's relay, its under-voltage nFAULT, TIM1's break |
 //!
 //! ```text
 //! every sample period h = 1/fs:
 //!   sensors → the AS5047P's register (14-bit angle with noise, its own zero and sign), read
 //!             through the firmware's driver (rig::as5047) → Sample
-//!   RigLoop::sample; when due RigLoop::control(crank counts, motor current, e-stop)
-//!                    → duty (0 while the bridge sleeps), θd for the servo
+//!   RigLoop::sample; when due RigLoop::control(crank counts, motor current, bridge lines,
+//!                    e-stop) → duty (0 while the bridge sleeps or its break holds), θd
+//!   the bridge: VM through the e-stop's relay; nFAULT low → TIM1's break cuts the outputs
 //!   servo slews the mount toward θd at its own rate;  plant: one RK4 step of h;
 //!   the body (if any) keeps the rod within 90° of the blade
 //! ```
@@ -28,6 +30,7 @@
 //! Everything is deterministic under [`Params::seed`].
 
 pub mod body;
+pub mod bridge;
 pub mod hand;
 pub mod plant;
 pub mod sensor;
@@ -38,6 +41,7 @@ use crate::math;
 use crate::model::Geometry;
 use crate::persist::ConfigOrigin;
 use crate::rig::as5047::As5047;
+use crate::rig::bridge::Lines;
 use crate::rig::calibration::Calibration;
 use crate::rig::config::RigConfig;
 use crate::rig::fixed::{Angle, Duty};
@@ -47,6 +51,7 @@ use crate::station::drive::Drive;
 use crate::station::serve::Activity;
 use crate::station::{RigLoop, Sample};
 use body::Body;
+use bridge::Bridge;
 use hand::Hand;
 use plant::{MotorModel, Plant};
 use sensor::{Chip, Line};
@@ -150,6 +155,8 @@ pub struct SimRig {
     servo_target_deg: f64,
     servo_deg: f64,
     pub estop: bool,
+    /// The H-bridge and TIM1's break; its supply can be made to sag.
+    pub bridge: Bridge,
     chip: Chip,
     driver: As5047,
     /// The last good count (a failed read repeats it, as the firmware does).
@@ -191,6 +198,7 @@ impl SimRig {
             servo_target_deg: servo0,
             servo_deg: servo0,
             estop: false,
+            bridge: Bridge::default(),
             chip: Chip::default(),
             driver: As5047::new(),
             held: 0,
@@ -251,19 +259,19 @@ impl SimRig {
             sensor_failed: self.driver.health().failed(),
             diagnostics: self.driver.health().diagnostics,
         };
+        self.bridge.update(self.estop);
         if self.rig.sample(s) {
             let mut hw = Hardware {
                 plant: &mut self.plant,
                 y: &self.y,
                 crank_sign: self.params.crank_sign,
                 current_offset: self.params.current_offset,
+                bridge: &mut self.bridge,
             };
             let tick = self
                 .rig
                 .control(link_us.unwrap_or(t_us), &mut hw, Some(self.estop));
-            if !tick.bridge {
-                self.plant.duty = 0.0;
-            }
+            self.bridge.set_awake(tick.bridge);
             if let Some(us) = tick.servo_us {
                 self.servo_target_deg = ServoMap::REFERENCE.deg_of_pulse(us);
             }
@@ -271,6 +279,9 @@ impl SimRig {
                 // The simulated flash always takes the write.
                 self.rig.config_saved(true);
             }
+        }
+        if !self.bridge.driving() {
+            self.plant.duty = 0.0;
         }
         let h = 1.0 / f64::from(self.rig.sample_hz());
         let theta_d_before = self.plant.theta_d;
@@ -364,6 +375,7 @@ struct Hardware<'a> {
     y: &'a [f64; 4],
     crank_sign: f64,
     current_offset: f64,
+    bridge: &'a mut Bridge,
 }
 
 impl Drive for Hardware<'_> {
@@ -381,5 +393,14 @@ impl Drive for Hardware<'_> {
     }
     fn set_duty(&mut self, duty: Duty) {
         self.plant.duty = duty.to_num();
+    }
+    fn bridge_lines(&mut self) -> Lines {
+        Lines {
+            nfault_low: self.bridge.nfault_low(),
+            break_flag: self.bridge.break_flag(),
+        }
+    }
+    fn rearm(&mut self) {
+        self.bridge.rearm();
     }
 }

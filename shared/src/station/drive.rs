@@ -6,14 +6,17 @@
 //! crank_raw: encoder as wired          →    crank angle = crank_sign · raw
 //! current_counts: ADC counts           →    current (A) = (counts − offset) · scale
 //! set_duty                             ←    duty
+//! bridge_lines: nFAULT, TIM1's BIF     →    bridge fault (rig::bridge), ignored asleep/waking
+//! rearm: clear BIF, set MOE            ←    an accepted ClearFault, or an ignored break
 //! ```
 
+use crate::rig::bridge::Lines;
 use crate::rig::calibration::{Calibration, CurrentSense};
 use crate::rig::fixed::{Amps, Angle, Duty};
 use crate::rig::phase_lock::Motor;
 
-/// The crank motor's hardware, uncalibrated: three methods the firmware implements on the
-/// encoder timer, the current ADC and the H-bridge PWM.
+/// The crank motor's hardware, uncalibrated: what the firmware implements on the encoder
+/// timer, the current ADC, the H-bridge PWM and its fault lines.
 pub trait Drive {
     /// The crank encoder's position as wired (one turn = 2^32, wrapping), before the
     /// calibrated sign.
@@ -22,6 +25,11 @@ pub trait Drive {
     fn current_counts(&mut self) -> u16;
     /// H-bridge command in [−1, 1); 0 stops driving.
     fn set_duty(&mut self, duty: Duty);
+    /// The H-bridge's fault lines now: nFAULT's level and TIM1's break flag (BIF).
+    fn bridge_lines(&mut self) -> Lines;
+    /// Clears TIM1's break flag and re-enables its outputs (MOE); the rig loop asks only while
+    /// nFAULT reads high.
+    fn rearm(&mut self);
 }
 
 /// A [`Drive`] seen through the calibration, with the tick's readings kept for the telemetry

@@ -8,7 +8,8 @@
 //! every pendulum sample  sample(s)   →  DDS tick, estimator; failed / late samples counted;
 //!                                       true when a control tick is due (every fs/fc samples)
 //! control tick  control(link_us, motor, e-stop)
-//!                                    →  safety, DDS, phase lock → duty; Tick: bridge on only
+//!                                    →  bridge lines (nFAULT, BIF: rig::bridge), safety, DDS,
+//!                                       phase lock → duty; a rearm; Tick: bridge on only
 //!                                       while running or stopping, θd for the servo when it
 //!                                       moved, a configuration to store; telemetry queued when due
 //! bytes from the laptop  receive(…)  →  frames checked and answered at once, in order;
@@ -58,6 +59,7 @@ use crate::link::message::{Check, Counters, RawTelemetry, ResetInfo, Verdict};
 use crate::link::{FrameReader, Request, Response, MAX_REQUEST_FRAME, MAX_RESPONSE_FRAME};
 use crate::persist::ConfigOrigin;
 use crate::rig::as5047::Diagnostics;
+use crate::rig::bridge::Watch;
 use crate::rig::config::RigConfig;
 use crate::rig::controller::ControlReport;
 use crate::rig::estop::EStop;
@@ -184,6 +186,10 @@ pub struct RigLoop {
     /// The last tick's raw crank reading and ADC counts, for the raw telemetry.
     raw_crank: Angle,
     counts: u16,
+    /// The bridge's nSLEEP as driven, to ignore nFAULT while it sleeps and wakes.
+    bridge: Watch,
+    /// A `ClearFault` was accepted: re-arm the bridge's outputs at the next tick.
+    rearm: bool,
 }
 
 impl RigLoop {
@@ -223,6 +229,8 @@ impl RigLoop {
             current: Amps::ZERO,
             raw_crank: Angle::ZERO,
             counts: 0,
+            bridge: Watch::new(),
+            rearm: false,
         }
     }
 
@@ -251,6 +259,9 @@ impl RigLoop {
         self.uptime_us += u64::from(s.t_us.wrapping_sub(self.last.t_us));
         self.last = s;
         self.srv.rig.sensor_failed(s.sensor_failed);
+        self.srv
+            .rig
+            .sensor_not_ready(s.diagnostics.is_some_and(|d| !d.ready));
         let angle = self.srv.cfg.calibration.pendulum_angle(s.count);
         self.srv.rig.sample(s.t_us, angle);
         if let Activity::Checking { check, .. } = &mut self.srv.activity {
@@ -267,10 +278,16 @@ impl RigLoop {
     /// The control tick, at the time of the last sample. `link_us` is the link's clock (the
     /// rig's own on hardware); `drive` the crank motor's hardware, read raw and calibrated
     /// here; `estop` the e-stop line as read now, `None` while it is unknown (pressed),
-    /// debounced here ([`crate::rig::estop`]).
+    /// debounced here ([`crate::rig::estop`]). The bridge's fault lines are read first: a
+    /// fault they show is latched at this tick ([`crate::rig::bridge`]); the outputs are
+    /// re-armed after an accepted `ClearFault`, or after a break the loop ignored while no
+    /// fault is latched, and only while nFAULT reads high.
     pub fn control<D: Drive>(&mut self, link_us: u32, drive: &mut D, estop: Option<bool>) -> Tick {
         self.estop = self.estop_line.update(estop);
         let t = self.last.t_us;
+        let lines = drive.bridge_lines();
+        let seen = self.bridge.check(t, lines);
+        self.srv.rig.bridge(lines.nfault_low, seen.fault);
         let cal = self.srv.cfg.calibration;
         let mut m = Calibrated::new(drive, &cal);
         let mut report = self.srv.rig.control_at(t, link_us, &mut m, self.estop);
@@ -306,8 +323,15 @@ impl RigLoop {
                 self.queue(self.telemetry_seq, &resp, true);
             }
         }
+        let awake = matches!(report.mode, Mode::Running | Mode::Stopping(_)) || extra;
+        self.bridge.drive(awake, t);
+        let faulted = matches!(report.mode, Mode::Faulted(_));
+        let rearm = core::mem::take(&mut self.rearm) || (seen.rearm && !faulted);
+        if rearm && seen.fault.is_none() && !lines.nfault_low {
+            drive.rearm();
+        }
         Tick {
-            bridge: matches!(report.mode, Mode::Running | Mode::Stopping(_)) || extra,
+            bridge: awake,
             servo_deg,
             servo_us: servo_deg.map(|d| self.srv.cfg.calibration.servo.pulse(d)),
             store: self.store.take(),
@@ -486,6 +510,7 @@ impl RigLoop {
                 self.telemetry_every = telemetry_ticks(period_ms, &self.srv.cfg);
                 self.since_telemetry = self.telemetry_every.saturating_sub(1);
             }
+            Effect::Rearm => self.rearm = true,
         }
         resp
     }

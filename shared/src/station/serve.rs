@@ -47,7 +47,7 @@ impl Command {
 /// SetDrive{R, θd}:  θd → SetDriveAngle (slewed);  R > 0: ω = ωc √R → Start (idle) or SetOmega;
 ///                   R = 0 → Stop;  R < 0 or not representable → RInvalid
 /// Stop:             soft stop; accepted while faulted too (the drive is already halted)
-/// ClearFault:       leaves Faulted once the e-stop is released
+/// ClearFault:       leaves Faulted once the e-stop is released and nFAULT reads high
 /// ```
 pub fn apply(rig: &mut Rig, cfg: &RigConfig, cmd: Command) -> Result<(), Reason> {
     let mut trial = *rig;
@@ -153,6 +153,9 @@ pub enum Effect {
     Telemetry {
         period_ms: u16,
     },
+    /// `ClearFault` was accepted: clear TIM1's break flag and re-enable the bridge's outputs
+    /// ([`super::drive::Drive::rearm`]).
+    Rearm,
 }
 
 /// When a request is answered: the rig's clock, the link's clock and the uptime.
@@ -275,6 +278,7 @@ impl RigServer {
                     None => Err(Reason::UnknownMessage),
                 };
                 match r {
+                    Ok(()) if req == Request::ClearFault => (Response::Ok, Effect::Rearm),
                     Ok(()) => (Response::Ok, Effect::None),
                     Err(reason) => (Response::Refused(reason), Effect::None),
                 }

@@ -2,8 +2,8 @@
 //! round-trip, size and golden-frame tests.
 
 use kapitza_core::link::message::{
-    Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo, SensorDiagnostics,
-    StopReason, Telemetry, Verdict, VersionInfo, WireConfig, WireGeometry,
+    BridgeLine, Check, Counters, Fault, Mode, RMethod, RawTelemetry, ResetCause, ResetInfo,
+    SensorDiagnostics, StopReason, Telemetry, Verdict, VersionInfo, WireConfig, WireGeometry,
 };
 use kapitza_core::link::origin::FieldSet;
 use kapitza_core::link::reason::ConfigField;
@@ -242,6 +242,14 @@ pub fn all() -> Vec<(&'static str, u8, Msg)> {
         ("status_faulted_phase_lock_lost", Fault::PhaseLockLost),
         ("status_faulted_over_current_rms", Fault::OverCurrentRms),
         ("status_faulted_duty_ceiling", Fault::DutyCeiling),
+        (
+            "status_faulted_bridge_nfault",
+            Fault::Bridge(BridgeLine::NFault),
+        ),
+        (
+            "status_faulted_bridge_break",
+            Fault::Bridge(BridgeLine::Break),
+        ),
     ]
     .into_iter()
     .enumerate()
@@ -373,6 +381,7 @@ pub fn reasons() -> Vec<(&'static str, Reason)> {
                 cap: 8_192,
             },
         ),
+        ("refused_bridge_fault_active", Reason::BridgeFaultActive),
     ]
 }
 
