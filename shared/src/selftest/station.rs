@@ -233,11 +233,11 @@ pub const CASES: &[Case] = &[
     Case {
         name: "rig_loop_conversation",
         run: rig_loop_conversation,
-        expected: 0x2288_21ae_9278_5160,
+        expected: 0x42bf_1013_2453_b8a5,
     },
     Case {
         name: "rig_loop_bridge_latch",
         run: rig_loop_bridge_latch,
-        expected: 0xaaf5_b80b_021f_b3d2,
+        expected: 0x3c29_40ea_6a76_14f3,
     },
 ];
