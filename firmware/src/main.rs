@@ -25,7 +25,8 @@ use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::pac;
 use kapitza_core::link::message::{ResetCause, ResetInfo};
-use kapitza_core::persist::ConfigOrigin;
+use embassy_time::Timer;
+use kapitza_core::persist::{self, ConfigOrigin};
 use kapitza_core::rig::servo;
 
 /// Firmware version, from this crate's Cargo.toml.
@@ -53,7 +54,15 @@ async fn main(spawner: Spawner) {
     }
     let mut b = board::split(p);
 
-    let (cfg, origin) = tasks::persist::load(&mut b.flash);
+    // The e-stop held at power-up boots on the safe defaults, the stored configuration left
+    // alone (kapitza_core::persist::store::boot). The first reading 1 ms after the pull-up is on.
+    let mut estop = [false; persist::store::ESTOP_BOOT_READINGS];
+    for r in &mut estop {
+        Timer::after_millis(1).await;
+        *r = b.drive.estop_active();
+    }
+    let mut flash = tasks::persist::Guarded(b.flash);
+    let (cfg, origin) = tasks::persist::load(&mut flash, persist::store::estop_held(estop));
     match origin {
         ConfigOrigin::Stored => info!("configuration: stored"),
         ConfigOrigin::Repaired { defaulted } => warn!(
@@ -80,7 +89,7 @@ async fn main(spawner: Spawner) {
     spawner.spawn(unwrap!(tasks::tilt::run(b.tilt)));
     spawner.spawn(unwrap!(tasks::safety::run(b.safety)));
     spawner.spawn(unwrap!(tasks::link::run(b.uart)));
-    spawner.spawn(unwrap!(tasks::persist::run(b.flash)));
+    spawner.spawn(unwrap!(tasks::persist::run(flash)));
 }
 
 /// Why the chip last reset (RCC_CSR's flags, cleared here so the next reset reports its own).

@@ -23,11 +23,11 @@ use serde_json::Value;
 
 const FLASH: u64 = 0x0800_0000;
 const RAM: u64 = 0x2000_0000;
-/// memory.x: 512 KiB of flash, 128 KiB of RAM; persist.x: the configuration page starts at
-/// 0x0807_F800 (the last 2 KiB page).
+/// memory.x: 512 KiB of flash, 128 KiB of RAM; persist.x: the configuration area starts at
+/// 0x0807_F000 (the last two 2 KiB pages).
 const FLASH_LEN: u64 = 512 * 1024;
 const RAM_LEN: u64 = 128 * 1024;
-const CONFIG_PAGE: u64 = 0x0807_F800;
+const CONFIG_PAGE: u64 = 0x0807_F000;
 
 /// One loadable segment of a crafted image: stored at `paddr`, run at `vaddr`, `file` bytes of
 /// data and `mem` bytes in memory.

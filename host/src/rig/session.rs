@@ -259,6 +259,7 @@ impl StatusView {
                 ConfigOrigin::Received { saved: true } => "received, saved".into(),
                 ConfigOrigin::Received { saved: false } => "received, not saved".into(),
                 ConfigOrigin::Defaults(f) => format!("safe defaults ({f:?})"),
+                ConfigOrigin::DefaultsByEstop => "defaults_by_estop".into(),
             },
             config_fallbacks: match s.config {
                 ConfigOrigin::Repaired { defaulted } => {

@@ -100,7 +100,7 @@ pub use message::{Request, Response, Status, Telemetry, VersionInfo, WireConfig}
 pub use reason::Reason;
 
 /// The link protocol version: the first byte of every frame. See the policy above.
-pub const PROTOCOL_VERSION: u8 = 5;
+pub const PROTOCOL_VERSION: u8 = 6;
 
 /// Line speed of the rig's serial port (8 data bits, no parity, 1 stop bit).
 pub const BAUD: u32 = 115_200;
