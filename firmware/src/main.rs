@@ -52,7 +52,7 @@ async fn main(spawner: Spawner) {
             k.theta_d_deg, k.last_fault
         );
     }
-    let mut b = board::split(p);
+    let b = board::split(p);
 
     // The e-stop held at power-up boots on the safe defaults, the stored configuration left
     // alone (kapitza_core::persist::store::boot). The first reading 1 ms after the pull-up is on.
