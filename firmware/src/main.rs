@@ -24,8 +24,8 @@ use defmt::{info, unwrap, warn};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::pac;
-use kapitza_core::link::message::{ResetCause, ResetInfo};
 use embassy_time::Timer;
+use kapitza_core::link::message::{ResetCause, ResetInfo};
 use kapitza_core::persist::{self, ConfigOrigin};
 use kapitza_core::rig::servo;
 

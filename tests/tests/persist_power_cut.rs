@@ -347,7 +347,9 @@ fn a_cut_at_any_word_of_a_store_leaves_the_old_or_the_new_configuration() {
             }
         }
     }
-    println!("{cuts} cut points: {olds} loaded the old configuration, {news} the new, none the defaults");
+    println!(
+        "{cuts} cut points: {olds} loaded the old configuration, {news} the new, none the defaults"
+    );
     assert_eq!(cuts, olds + news);
     // Every completed store loads the new one (a cut whose last word happened to program
     // whole loads it too).
@@ -374,7 +376,10 @@ fn a_format_3_record_at_the_old_address_loads() {
     let seq = store::store(&mut f, &AREA, &config(1)).unwrap();
     assert_eq!(seq, 1);
     assert_eq!(&f.mem[at..at + b.len()], &b[..]);
-    assert_eq!(store::load(&mut f, &AREA), (config(1), ConfigOrigin::Stored));
+    assert_eq!(
+        store::load(&mut f, &AREA),
+        (config(1), ConfigOrigin::Stored)
+    );
 }
 
 #[test]
@@ -382,12 +387,18 @@ fn stores_in_a_row_alternate_pages_and_the_newest_loads() {
     let mut f = Flash::new(9);
     assert_eq!(
         store::load(&mut f, &AREA),
-        (RigConfig::REFERENCE, ConfigOrigin::Defaults(Fallback::Missing))
+        (
+            RigConfig::REFERENCE,
+            ConfigOrigin::Defaults(Fallback::Missing)
+        )
     );
     for k in 1..=5 {
         let seq = store::store(&mut f, &AREA, &config(k)).unwrap();
         assert_eq!(seq, k);
-        assert_eq!(store::load(&mut f, &AREA), (config(k), ConfigOrigin::Stored));
+        assert_eq!(
+            store::load(&mut f, &AREA),
+            (config(k), ConfigOrigin::Stored)
+        );
     }
     // Five stores from empty: pages 0,1,0,1,0, one erase each.
     assert_eq!(f.erases, 5);
@@ -405,7 +416,10 @@ fn both_pages_damaged_load_the_defaults_and_say_why() {
     f.mem[AREA.page(1) as usize + 33] ^= 0x01;
     assert_eq!(
         store::load(&mut f, &AREA),
-        (RigConfig::REFERENCE, ConfigOrigin::Defaults(Fallback::Corrupt))
+        (
+            RigConfig::REFERENCE,
+            ConfigOrigin::Defaults(Fallback::Corrupt)
+        )
     );
     // An ECC error in one and an erased other: still "corrupt", the more telling reason.
     let mut f = Flash::new(12);
@@ -413,7 +427,10 @@ fn both_pages_damaged_load_the_defaults_and_say_why() {
     f.ecc.insert(AREA.page(1) as usize / WORD);
     assert_eq!(
         store::load(&mut f, &AREA),
-        (RigConfig::REFERENCE, ConfigOrigin::Defaults(Fallback::Corrupt))
+        (
+            RigConfig::REFERENCE,
+            ConfigOrigin::Defaults(Fallback::Corrupt)
+        )
     );
 }
 

@@ -58,7 +58,10 @@ impl ReadNorFlash for Guarded {
         let r = self.0.blocking_read(offset, bytes);
         READING_CONFIG.store(false, Ordering::SeqCst);
         if ECC_ERROR.load(Ordering::SeqCst) {
-            warn!("persist: double ECC error at {=u32:#x} (power lost mid-write?)", offset);
+            warn!(
+                "persist: double ECC error at {=u32:#x} (power lost mid-write?)",
+                offset
+            );
             return Err(GuardedError::Ecc);
         }
         r.map_err(GuardedError::Flash)
@@ -78,7 +81,9 @@ impl NorFlash for Guarded {
     }
 
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), GuardedError> {
-        self.0.blocking_write(offset, bytes).map_err(GuardedError::Flash)
+        self.0
+            .blocking_write(offset, bytes)
+            .map_err(GuardedError::Flash)
     }
 }
 

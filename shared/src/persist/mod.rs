@@ -117,7 +117,9 @@ pub fn read(bytes: &[u8]) -> Result<Record, Fallback> {
         });
     }
     let body = bytes.get(..start + n).ok_or(Fallback::Corrupt)?;
-    let crc = bytes.get(start + n..start + n + 4).ok_or(Fallback::Corrupt)?;
+    let crc = bytes
+        .get(start + n..start + n + 4)
+        .ok_or(Fallback::Corrupt)?;
     if CRC.checksum(body) != u32::from_le_bytes([crc[0], crc[1], crc[2], crc[3]]) {
         return Err(Fallback::Corrupt);
     }
@@ -128,8 +130,8 @@ pub fn read(bytes: &[u8]) -> Result<Record, Fallback> {
         UNSEQUENCED | RECORD_VERSION => RigConfig::from(payload::<WireConfig>(p)?),
         _ => return Err(Fallback::Incompatible { version }),
     };
-    let seq = (version > UNSEQUENCED)
-        .then(|| u32::from_le_bytes([body[8], body[9], body[10], body[11]]));
+    let seq =
+        (version > UNSEQUENCED).then(|| u32::from_le_bytes([body[8], body[9], body[10], body[11]]));
     Ok(Record { cfg, seq })
 }
 
