@@ -130,5 +130,5 @@ fn rig_loop_conversation() -> u64 {
 pub const CASES: &[Case] = &[Case {
     name: "rig_loop_conversation",
     run: rig_loop_conversation,
-    expected: 0xb599_4cde_cb93_8b64,
+    expected: 0x2288_21ae_9278_5160,
 }];
