@@ -402,7 +402,7 @@ mod tests {
         stored.calibration.pendulum_zero = 999;
         stored.limits.link_timeout_ms = 0;
         let mut buf = [0u8; persist::RECORD_MAX];
-        persist::encode(&stored, &mut buf);
+        persist::encode(&stored, 1, &mut buf);
         let (cfg, origin) = persist::load(&buf);
         assert_eq!(cfg.calibration.pendulum_zero, 999);
         assert_eq!(cfg.limits.link_timeout_ms, 1000);
