@@ -153,7 +153,7 @@ impl NorFlash for Flash {
             return Err(ModelError::Off);
         }
         let (from, to) = (from as usize, to as usize);
-        if from % PAGE != 0 || to % PAGE != 0 || to > CAPACITY || from > to {
+        if !from.is_multiple_of(PAGE) || !to.is_multiple_of(PAGE) || to > CAPACITY || from > to {
             return Err(ModelError::Bounds);
         }
         for page in (from..to).step_by(PAGE) {
@@ -184,7 +184,10 @@ impl NorFlash for Flash {
             return Err(ModelError::Off);
         }
         let a = offset as usize;
-        if a % WORD != 0 || bytes.len() % WORD != 0 || a + bytes.len() > CAPACITY {
+        if !a.is_multiple_of(WORD)
+            || !bytes.len().is_multiple_of(WORD)
+            || a + bytes.len() > CAPACITY
+        {
             return Err(ModelError::Bounds);
         }
         for (i, chunk) in bytes.chunks(WORD).enumerate() {
