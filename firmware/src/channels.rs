@@ -9,8 +9,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_sync::watch::Watch;
-use kapitza_core::rig::config::RigConfig;
-use kapitza_core::station::Sample;
+use kapitza_core::station::{Sample, StoreRequest};
 
 /// pendulum → control: every sample, at the sample rate (a few in flight at most).
 pub static SAMPLES: Channel<Cs, Sample, 8> = Channel::new();
@@ -29,7 +28,8 @@ pub static TO_LAPTOP: Pipe<Cs, 512> = Pipe::new();
 pub static SERVO_US: Signal<Cs, f64> = Signal::new();
 /// control → safety: the control loop completed a tick (the watchdog is fed only then).
 pub static HEARTBEAT: Signal<Cs, ()> = Signal::new();
-/// control → persist: a configuration was accepted; store it.
-pub static SAVE_CONFIG: Signal<Cs, RigConfig> = Signal::new();
-/// persist → control: whether the last store reached flash.
-pub static CONFIG_SAVED: Signal<Cs, bool> = Signal::new();
+/// control → persist: a configuration was accepted; store it (a newer one replaces one not
+/// yet taken).
+pub static SAVE_CONFIG: Signal<Cs, StoreRequest> = Signal::new();
+/// persist → control: the tag of the store that finished, and whether it reached flash.
+pub static CONFIG_SAVED: Signal<Cs, (u32, bool)> = Signal::new();

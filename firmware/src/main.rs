@@ -24,8 +24,9 @@ use defmt::{info, unwrap, warn};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::pac;
+use embassy_time::Timer;
 use kapitza_core::link::message::ResetInfo;
-use kapitza_core::persist::ConfigOrigin;
+use kapitza_core::persist::{self, ConfigOrigin};
 use kapitza_core::rig::retained::ResetFlags;
 use kapitza_core::rig::servo;
 
@@ -73,9 +74,17 @@ async fn main(spawner: Spawner) {
             k.theta_d_deg, k.last_fault
         );
     }
-    let mut b = board::split(p);
+    let b = board::split(p);
 
-    let (cfg, origin) = tasks::persist::load(&mut b.flash);
+    // The e-stop held at power-up boots on the safe defaults, the stored configuration left
+    // alone (kapitza_core::persist::store::boot). The first reading 1 ms after the pull-up is on.
+    let mut estop = [false; persist::store::ESTOP_BOOT_READINGS];
+    for r in &mut estop {
+        Timer::after_millis(1).await;
+        *r = b.drive.estop_active();
+    }
+    let mut flash = tasks::persist::Guarded(b.flash);
+    let (cfg, origin) = tasks::persist::load(&mut flash, persist::store::estop_held(estop));
     match origin {
         ConfigOrigin::Stored => info!("configuration: stored"),
         ConfigOrigin::Repaired { defaulted } => warn!(
@@ -98,7 +107,7 @@ async fn main(spawner: Spawner) {
     spawner.spawn(unwrap!(tasks::tilt::run(b.tilt)));
     spawner.spawn(unwrap!(tasks::safety::run(b.safety)));
     spawner.spawn(unwrap!(tasks::link::run(b.uart)));
-    spawner.spawn(unwrap!(tasks::persist::run(b.flash)));
+    spawner.spawn(unwrap!(tasks::persist::run(flash)));
 }
 
 /// The chip's reset flags (RCC_CSR), cleared here so the next reset reports its own.

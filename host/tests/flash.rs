@@ -23,11 +23,11 @@ use serde_json::Value;
 
 const FLASH: u64 = 0x0800_0000;
 const RAM: u64 = 0x2000_0000;
-/// memory.x: 512 KiB of flash, 128 KiB of RAM; persist.x: the configuration page starts at
-/// 0x0807_F800 (the last 2 KiB page).
+/// memory.x: 512 KiB of flash, 128 KiB of RAM; persist.x: the configuration area starts at
+/// 0x0807_F000 (the last two 2 KiB pages).
 const FLASH_LEN: u64 = 512 * 1024;
 const RAM_LEN: u64 = 128 * 1024;
-const CONFIG_PAGE: u64 = 0x0807_F800;
+const CONFIG_PAGE: u64 = 0x0807_F000;
 
 /// One loadable segment of a crafted image: stored at `paddr`, run at `vaddr`, `file` bytes of
 /// data and `mem` bytes in memory.
@@ -170,7 +170,7 @@ fn dry_run_reports_what_goes_where() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(text.contains("0x08001100..0x08001200"), "{text}");
     assert!(text.contains("copied to 0x20000000"), "{text}");
-    assert!(text.contains("0x0807f800..0x08080000"), "{text}");
+    assert!(text.contains("0x0807f000..0x08080000"), "{text}");
     assert!(text.contains("nothing written"), "{text}");
 }
 
@@ -212,7 +212,7 @@ fn an_image_into_the_configuration_page_is_too_large() {
     let o = kapitza(&["flash", &path, "--dry-run"]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
-    assert!(e.contains("too large") && e.contains("0x0807f800"), "{e}");
+    assert!(e.contains("too large") && e.contains("0x0807f000"), "{e}");
 
     // One byte short of the page fits.
     let fits = elf(

@@ -881,3 +881,14 @@ fn calibration_finds_reversed_directions() {
         "zero count {zero}"
     );
 }
+
+/// `rig serve --estop-at-power-up`: the rig boots as a board powered up with its e-stop held,
+/// on the safe defaults, and says so.
+#[test]
+fn a_rig_powered_up_with_the_estop_held_runs_on_defaults_and_says_so() {
+    let rig = serve(&["--estop-at-power-up"]);
+    let port = rig.first_line.as_str();
+    let s = json(&kapitza(&["status", "--port", port, "--json"]));
+    assert_eq!(s["config"], "defaults_by_estop", "{s}");
+    assert_eq!(s["estop"], false, "released after power-up: {s}");
+}

@@ -516,7 +516,7 @@ proptest! {
     ) {
         let rig: kapitza_core::rig::config::RigConfig = cfg.into();
         let mut buf = [0u8; persist::RECORD_MAX];
-        let n = persist::encode(&rig, &mut buf);
+        let n = persist::encode(&rig, 1, &mut buf);
         match (persist::decode(&buf), rig.validate()) {
             (Ok(c), Ok(_)) => prop_assert_eq!(bytes(&WireConfig::from(c)), bytes(&cfg)),
             (Err(Fallback::Invalid { .. }), Err(_)) => {}

@@ -36,7 +36,7 @@ fn a_version_1_record_loads_with_the_former_build_constants() {
     assert_eq!(cfg.limits.duty_max, 1.0);
     // Rewritten, it is a current record of the same configuration.
     let mut buf = [0u8; RECORD_MAX];
-    let n = persist::encode(&cfg, &mut buf);
+    let n = persist::encode(&cfg, 1, &mut buf);
     assert_eq!(&buf[4..6], &persist::RECORD_VERSION.to_le_bytes());
     assert_eq!(persist::decode(&buf[..n]), Ok(want));
 }
@@ -60,7 +60,7 @@ fn a_version_2_record_loads_without_a_connecting_rod() {
     assert_eq!(cfg, want);
     assert_eq!(cfg.connecting_rod, 0.0);
     let mut buf = [0u8; RECORD_MAX];
-    let n = persist::encode(&cfg, &mut buf);
+    let n = persist::encode(&cfg, 1, &mut buf);
     assert_eq!(&buf[4..6], &persist::RECORD_VERSION.to_le_bytes());
     assert_eq!(persist::decode(&buf[..n]), Ok(want));
 }

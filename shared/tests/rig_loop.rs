@@ -329,6 +329,39 @@ fn the_same_configuration_is_not_stored_again() {
     assert_eq!(b.ticks.iter().filter(|t| t.store.is_some()).count(), 1);
 }
 
+/// A second `SetConfig` while the first is being stored: the first store's "saved" says
+/// nothing of the second configuration, so the status stays "not saved" until the second's
+/// own outcome arrives.
+#[test]
+fn only_the_newest_store_s_outcome_counts() {
+    let mut b = Bench::new(ConfigOrigin::Stored);
+    let mut first = CFG;
+    first.amplitude = 0.011;
+    b.send(1, &Request::SetConfig(first.into()));
+    b.run_ms(2);
+    let mut second = CFG;
+    second.amplitude = 0.012;
+    b.send(2, &Request::SetConfig(second.into()));
+    b.run_ms(2);
+    let stores: Vec<_> = b.ticks.iter().filter_map(|t| t.store).collect();
+    assert_eq!(stores.len(), 2);
+    assert_eq!(stores[0].cfg.amplitude, 0.011);
+    assert_eq!(stores[1].cfg.amplitude, 0.012);
+    assert_ne!(stores[0].tag, stores[1].tag);
+    b.drain();
+    // The first store finishes: ignored.
+    b.rig.config_saved(stores[0].tag, true);
+    assert_eq!(b.status().config, ConfigOrigin::Received { saved: false });
+    // The second one's outcome counts, whichever it is.
+    b.rig.config_saved(stores[1].tag, false);
+    assert_eq!(b.status().config, ConfigOrigin::Received { saved: false });
+    b.rig.config_saved(stores[1].tag, true);
+    assert_eq!(b.status().config, ConfigOrigin::Received { saved: true });
+    // A late outcome of the first store changes nothing any more.
+    b.rig.config_saved(stores[0].tag, false);
+    assert_eq!(b.status().config, ConfigOrigin::Received { saved: true });
+}
+
 #[test]
 fn nobody_reading_drops_telemetry_never_the_loop() {
     let mut b = Bench::new(ConfigOrigin::Stored);

@@ -19,7 +19,7 @@
 //! | laptop link TX / RX | PA2 / PA3 | USART2, 115200 8N1 | ST-LINK virtual COM port |
 //! | (time driver) | — | TIM2 | `time-driver-tim2` in Cargo.toml |
 //! | (control-loop executor) | — | UART4 interrupt | unused peripheral, its IRQ runs the executor |
-//! | (configuration record) | — | flash page 0x0807_F800 | last 2 KiB page of bank 2 |
+//! | (configuration record) | — | flash 0x0807_F000..0x0808_0000 | last two 2 KiB pages of bank 2 |
 
 use embassy_stm32::adc::{Adc, AdcChannel, AdcConfig, AnyAdcChannel, SampleTime};
 use embassy_stm32::flash::{Blocking, Flash};
@@ -136,10 +136,11 @@ pub fn chip_config() -> Config {
 /// sense's offset and gain — are not build constants: they are the configuration's
 /// calibration, set over the link and stored in flash.)
 pub const CRANK_COUNTS: u32 = 8192;
-/// The flash page that holds the configuration record: offset from the flash base, and size.
+/// The flash area that holds the configuration records, two 2 KiB pages
+/// (`kapitza_core::persist::store`): offset from the flash base, and size of both.
 /// `persist.x` asserts that the program image stays below it.
-pub const CONFIG_PAGE_OFFSET: u32 = 0x7_F800;
-pub const CONFIG_PAGE_SIZE: u32 = 2048;
+pub const CONFIG_PAGE_OFFSET: u32 = 0x7_F000;
+pub const CONFIG_PAGE_SIZE: u32 = 4096;
 /// The widest pulse range any servo calibration may ask for (µs): the configuration's own
 /// range is checked when it is set (`kapitza_core::rig::calibration`), this is the board's last
 /// word.

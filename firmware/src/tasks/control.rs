@@ -112,8 +112,8 @@ pub async fn run(
         if LINE_ERROR.try_take().is_some() {
             rig.line_error();
         }
-        if let Some(ok) = CONFIG_SAVED.try_take() {
-            rig.config_saved(ok);
+        if let Some((tag, ok)) = CONFIG_SAVED.try_take() {
+            rig.config_saved(tag, ok);
         }
         let estop = drive.estop_active();
         let tick = rig.control(t, &mut Hw { drive: &mut drive }, Some(estop));
@@ -132,7 +132,7 @@ pub async fn run(
             retained::store(&keep);
         }
         if let Some(new) = tick.store {
-            SAMPLE_HZ.sender().send(new.sample_hz);
+            SAMPLE_HZ.sender().send(new.cfg.sample_hz);
             SAVE_CONFIG.signal(new);
         }
         HEARTBEAT.signal(());

@@ -64,6 +64,10 @@ pub struct ServeArgs {
     /// Speak this link protocol version instead of this tool's (for tests of version skew).
     #[arg(long, hide = true)]
     pub protocol: Option<u8>,
+    /// Power up as with the e-stop held: on the safe defaults (status `config` =
+    /// "defaults_by_estop"), the rig file's configuration unused; the e-stop is released after.
+    #[arg(long)]
+    pub estop_at_power_up: bool,
 }
 
 pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
@@ -79,6 +83,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<()> {
     };
     let mut opts = rig.sim_options()?;
     opts.protocol = a.protocol;
+    opts.estop_at_power_up = a.estop_at_power_up;
     let duration = a
         .duration
         .map(|d| crate::input::positive("--duration", d))

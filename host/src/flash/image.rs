@@ -274,8 +274,8 @@ impl Plan {
             );
         }
         s += &format!(
-            "flash  {} of {} ({:.1} %); the configuration page {:#010x}..{:#010x} ({}) is left \
-             as it is\n",
+            "flash  {} of {} ({:.1} %); the configuration area {:#010x}..{:#010x} ({}, two pages) \
+             is left as it is\n",
             kib(self.flash.used),
             kib(self.flash.region.len()),
             100.0 * self.flash.fraction,

@@ -1,6 +1,7 @@
 //! Where the firmware may live: the FLASH and RAM regions of the repository's `memory.x` (the
-//! linker's own map, compiled in) and the configuration page the firmware keeps at the end of
-//! flash (the address `firmware/persist.x` asserts the program image stays below).
+//! linker's own map, compiled in) and the configuration area the firmware keeps at the end of
+//! flash, two 2 KiB pages (from the address `firmware/persist.x` asserts the program image stays
+//! below).
 
 use std::ops::Range;
 
@@ -42,7 +43,8 @@ impl Region {
 pub struct MemoryMap {
     pub flash: Region,
     pub ram: Region,
-    /// Kept by the firmware for its stored configuration; flashing never touches it.
+    /// Kept by the firmware for its stored configuration (both pages of its store); flashing
+    /// never touches it.
     pub config_page: Region,
 }
 
@@ -162,7 +164,7 @@ mod tests {
     use super::*;
 
     /// The NUCLEO-G474RE's map (RM0440: 512 KiB flash at 0x0800_0000, 128 KiB SRAM at
-    /// 0x2000_0000) and the last 2 KiB page for the configuration.
+    /// 0x2000_0000) and the last two 2 KiB pages for the configuration.
     #[test]
     fn the_firmware_map_is_the_g474s() {
         let m = MemoryMap::firmware();
@@ -183,13 +185,13 @@ mod tests {
         assert_eq!(
             m.config_page,
             Region {
-                start: 0x0807_F800,
+                start: 0x0807_F000,
                 end: 0x0808_0000
             }
         );
     }
 
-    /// The page persist.x guards is the one the firmware writes (`board::CONFIG_PAGE_OFFSET`
+    /// The area persist.x guards is the one the firmware writes (`board::CONFIG_PAGE_OFFSET`
     /// and `CONFIG_PAGE_SIZE`, read from the board file).
     #[test]
     fn the_config_page_is_the_boards() {

@@ -275,6 +275,7 @@ impl StatusView {
                 ConfigOrigin::Received { saved: true } => "received, saved".into(),
                 ConfigOrigin::Received { saved: false } => "received, not saved".into(),
                 ConfigOrigin::Defaults(f) => format!("safe defaults ({f:?})"),
+                ConfigOrigin::DefaultsByEstop => "defaults_by_estop".into(),
             },
             config_fallbacks: match s.config {
                 ConfigOrigin::Repaired { defaulted } => {
@@ -428,7 +429,7 @@ mod tests {
         stored.calibration.pendulum_zero = 999;
         stored.limits.link_timeout_ms = 0;
         let mut buf = [0u8; persist::RECORD_MAX];
-        persist::encode(&stored, &mut buf);
+        persist::encode(&stored, 1, &mut buf);
         let (cfg, origin) = persist::load(&buf);
         assert_eq!(cfg.calibration.pendulum_zero, 999);
         assert_eq!(cfg.limits.link_timeout_ms, 1000);

@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use kapitza_core::link::convert::deg_along_travel;
 use kapitza_core::link::message::Check;
 use kapitza_core::persist::ConfigOrigin;
+use kapitza_core::rig::config::RigConfig;
 use kapitza_core::rig::dds::omega_of_word;
 use kapitza_core::simrig::SimRig;
 use kapitza_core::station::serve::{Activity, RigServer};
@@ -45,6 +46,9 @@ pub struct SimOptions {
     pub speed: f64,
     /// Speak another link protocol version (for tests of version skew).
     pub protocol: Option<u8>,
+    /// Power up with the e-stop held: the safe defaults, the rig file's configuration (the
+    /// flash's) left for the next power-up (`persist::store::boot`).
+    pub estop_at_power_up: bool,
 }
 
 impl SimOptions {
@@ -53,13 +57,19 @@ impl SimOptions {
             rig,
             speed,
             protocol: None,
+            estop_at_power_up: false,
         }
     }
 
     /// The rig, powered up with its configuration as if loaded from flash.
     pub fn build(&self) -> SimRig {
         let r = &self.rig;
-        let sim = SimRig::new(r.params, r.config, ConfigOrigin::Stored, FIRMWARE);
+        let (cfg, origin) = if self.estop_at_power_up {
+            (RigConfig::REFERENCE, ConfigOrigin::DefaultsByEstop)
+        } else {
+            (r.config, ConfigOrigin::Stored)
+        };
+        let sim = SimRig::new(r.params, cfg, origin, FIRMWARE);
         match self.protocol {
             Some(v) => sim.speaking(v),
             None => sim,

@@ -63,4 +63,7 @@ pub enum ConfigOrigin {
     Defaults(Fallback),
     /// Set over the link since power-up; `saved` says whether it reached flash.
     Received { saved: bool },
+    /// The e-stop was held at power-up: running on the safe defaults, the stored configuration
+    /// neither read nor erased (it loads at the next power-up without the e-stop).
+    DefaultsByEstop,
 }

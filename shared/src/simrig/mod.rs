@@ -275,9 +275,9 @@ impl SimRig {
             if let Some(us) = tick.servo_us {
                 self.servo_target_deg = ServoMap::REFERENCE.deg_of_pulse(us);
             }
-            if tick.store.is_some() {
+            if let Some(req) = tick.store {
                 // The simulated flash always takes the write.
-                self.rig.config_saved(true);
+                self.rig.config_saved(req.tag, true);
             }
         }
         if !self.bridge.driving() {

@@ -15,7 +15,8 @@
 //! bytes from the laptop  receive(…)  →  frames checked and answered at once, in order;
 //!                                       the answers queued behind earlier frames
 //! the line can take bytes  transmit  →  queued frame bytes, oldest first
-//! flash written  config_saved(ok)
+//! flash written  config_saved(tag, ok)
+//!                                 →  counts only for the newest store asked for
 //! ```
 //!
 //! **Requests are answered where they are decoded**, in the caller's control context, so there
@@ -109,11 +110,18 @@ pub struct Tick {
     pub servo_deg: Option<f64>,
     /// The same as the servo's pulse width (µs, unrounded), through the calibrated map.
     pub servo_us: Option<f64>,
-    /// A configuration was accepted: write it to flash, then call [`RigLoop::config_saved`].
-    /// Its sample rate is in use from the next sample on.
-    pub store: Option<RigConfig>,
+    /// A configuration was accepted: write it to flash, then call [`RigLoop::config_saved`]
+    /// with its tag. Its sample rate is in use from the next sample on.
+    pub store: Option<StoreRequest>,
     /// What the control tick did.
     pub report: ControlReport,
+}
+
+/// A configuration to store, tagged so that its outcome is told apart from an earlier store's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StoreRequest {
+    pub tag: u32,
+    pub cfg: RigConfig,
 }
 
 /// Frame bytes waiting for the line: a byte ring of fixed size.
@@ -179,7 +187,9 @@ pub struct RigLoop {
     estop_line: EStop,
     /// The θd and the servo map of the last pulse sent: a new map (calibration) resends it.
     servo: Option<(Angle, ServoMap)>,
-    store: Option<RigConfig>,
+    store: Option<StoreRequest>,
+    /// The tag of the newest store asked for: only its outcome counts.
+    store_tag: u32,
     last: Sample,
     uptime_us: u64,
     current: Amps,
@@ -217,6 +227,7 @@ impl RigLoop {
             estop_line: EStop::new(),
             servo: None,
             store: None,
+            store_tag: 0,
             last: Sample {
                 t_us: now_us,
                 count: cfg.calibration.pendulum_zero,
@@ -466,9 +477,13 @@ impl RigLoop {
         self.out.len
     }
 
-    /// The store asked for by [`Tick::store`] finished (`ok`: it reached flash).
-    pub fn config_saved(&mut self, ok: bool) {
-        self.srv.config_saved(ok);
+    /// The store asked for by [`Tick::store`] with `tag` finished (`ok`: it reached flash).
+    /// The outcome of a store that a newer one has overtaken says nothing about the
+    /// configuration in use, and is ignored.
+    pub fn config_saved(&mut self, tag: u32, ok: bool) {
+        if tag == self.store_tag {
+            self.srv.config_saved(ok);
+        }
     }
 
     /// The rig and its configuration, counters and origin.
@@ -503,7 +518,11 @@ impl RigLoop {
                 self.samples_per_control = per_control(&cfg);
                 self.since_control = 0;
                 self.telemetry_every = telemetry_ticks(self.telemetry_ms, &cfg);
-                self.store = Some(cfg);
+                self.store_tag = self.store_tag.wrapping_add(1);
+                self.store = Some(StoreRequest {
+                    tag: self.store_tag,
+                    cfg,
+                });
             }
             Effect::Telemetry { period_ms } => {
                 self.telemetry_ms = period_ms;
