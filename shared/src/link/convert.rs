@@ -3,8 +3,7 @@
 
 use super::message::{
     BridgeLine, Fault, Mode, RMethod, ResetCause, ResetInfo, SensorDiagnostics, StopReason,
-    WireCalibration,
-    WireClosedLoop, WireConfig, WireGeometry, Q16,
+    WireCalibration, WireClosedLoop, WireConfig, WireGeometry, Q16,
 };
 use super::reason::{ConfigField, Reason};
 use crate::model::{self, Geometry};
