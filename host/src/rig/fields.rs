@@ -74,8 +74,9 @@ fn words(field: Field) -> (&'static str, &'static str) {
         ),
         F::ControlHz => (
             "Hz",
-            "the watchdog is 3 control periods: at 100 Hz and above it fires within 30 ms of \
-             a stuck control loop (and the sample rate, a multiple, tops it)",
+            "the watchdog's timeout covers 3 control periods and a flash page's erase and \
+             program at the floor (72.9 ms, `rig::watchdog`), so no accepted rate can starve it \
+             (and the sample rate, a multiple, tops it)",
         ),
         F::SampleHz => (
             "Hz",
