@@ -7,7 +7,7 @@
 
 use std::fs::{File, Metadata, OpenOptions};
 use std::io::ErrorKind;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
@@ -152,6 +152,27 @@ pub fn create_output(flag: &str, path: &Path, mode: Existing) -> Result<File> {
             anyhow::Error::new(e).context(format!("{flag} {}: cannot create", path.display()))
         }
     })
+}
+
+/// Creates a new file `STEM.EXT` in `dir` (made if missing), or `STEM-2.EXT`, `STEM-3.EXT`, …
+/// when that name is taken: for the files the tool writes on its own (backups), which must
+/// never replace one. Returns the file and its path.
+pub fn create_new_in(dir: &Path, stem: &str, ext: &str) -> Result<(File, PathBuf)> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+    for n in 1..=1000 {
+        let name = match n {
+            1 => format!("{stem}.{ext}"),
+            n => format!("{stem}-{n}.{ext}"),
+        };
+        let path = dir.join(name);
+        match OpenOptions::new().write(true).create_new(true).open(&path) {
+            Ok(f) => return Ok((f, path)),
+            Err(e) if e.kind() == ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e).with_context(|| format!("cannot create {}", path.display())),
+        }
+    }
+    bail!("{}: no free name for {stem}.{ext}", dir.display())
 }
 
 /// Whether `file` (just opened) is empty: a log appended to writes its header only then.

@@ -83,31 +83,13 @@ pub fn backup_dir() -> Result<PathBuf> {
 
 /// Creates a new default backup file (never an existing one), returning it and its path.
 fn new_default_backup() -> Result<(std::fs::File, PathBuf)> {
-    let dir = backup_dir()?;
-    std::fs::create_dir_all(&dir)
-        .with_context(|| format!("cannot create the backup folder {}", dir.display()))?;
     let t = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
-    for n in 0..100 {
-        let name = match n {
-            0 => format!("config-before-calibrate-{t}.toml"),
-            n => format!("config-before-calibrate-{t}-{n}.toml"),
-        };
-        let path = dir.join(name);
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&path)
-        {
-            Ok(f) => return Ok((f, path)),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e).with_context(|| format!("cannot create {}", path.display())),
-        }
-    }
-    anyhow::bail!(
-        "{}: no free backup name; give one with --backup FILE",
-        dir.display()
+    files::create_new_in(
+        &backup_dir()?,
+        &format!("config-before-calibrate-{t}"),
+        "toml",
     )
 }
 

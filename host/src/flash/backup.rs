@@ -13,7 +13,7 @@ use serde::Serialize;
 use super::board::Board;
 use super::memory_map::Region;
 use super::option_bytes::{self, OptionBytes};
-use crate::files::{self, Existing};
+use crate::files;
 use crate::rig::{Exit, Failure};
 
 /// What `kapitza flash` does to the configuration area around writing the image.
@@ -161,25 +161,12 @@ pub fn is_blank(area: &[u8]) -> bool {
 /// Saves `area` as a new file in `dir` (created if missing): `config-BOARD-UTCTIME.bin`, with
 /// `-2`, `-3`, … when that name is taken. An existing file is never replaced.
 pub fn save(dir: &Path, board: &str, area: &[u8]) -> Result<PathBuf> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the backup folder {}", dir.display()))?;
     let stem = format!("config-{}-{}", file_safe(board), utc_stamp());
-    for n in 1.. {
-        let name = match n {
-            1 => format!("{stem}.bin"),
-            n => format!("{stem}-{n}.bin"),
-        };
-        let path = dir.join(name);
-        if path.exists() {
-            continue;
-        }
-        let mut file = files::create_output("backup", &path, Existing::Refuse)?;
-        file.write_all(area)
-            .and_then(|()| file.sync_all())
-            .with_context(|| format!("writing the backup {}", path.display()))?;
-        return Ok(path);
-    }
-    unreachable!("an unbounded range ends only by returning")
+    let (mut file, path) = files::create_new_in(dir, &stem, "bin")?;
+    file.write_all(area)
+        .and_then(|()| file.sync_all())
+        .with_context(|| format!("writing the backup {}", path.display()))?;
+    Ok(path)
 }
 
 /// `YYYYMMDDTHHMMSSZ`, now.

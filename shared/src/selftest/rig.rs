@@ -366,13 +366,13 @@ fn bench_faults() -> u64 {
         };
         d.u32(u32::from(e.update(reading)));
     }
-    let mut due = 0u64;
+    // A sample clock of 100 ticks a sample, run late by up to 3.5 periods.
+    let mut clock = crate::station::clock::SampleClock::new(0, 100, 1);
     for k in 0..300u64 {
-        let now = due + (k * k * 7919) % 350;
-        let (n, skipped) = crate::station::next_due(due, now, 100);
+        let now = clock.due() + (k * k * 7919) % 350;
+        let (n, skipped) = clock.advance(now);
         d.u64(n);
         d.u64(skipped);
-        due = n;
     }
     let cfg = RigConfig::REFERENCE;
     let mut s = Supervisor::new(&cfg, Angle::ZERO, 0);

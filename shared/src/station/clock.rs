@@ -11,8 +11,9 @@
 //!
 //! so k samples always take k/f seconds to within one tick, and the error never grows (the
 //! remainder `k · F mod f` is carried, not dropped). Late samples are skipped, never caught up
-//! in a burst, as [`super::next_due`] does on a whole-tick grid: the deadline after a late one
-//! is the first grid point still ahead.
+//! in a burst: the deadline after a late one is the first grid point still ahead, and the
+//! deadlines passed on the way are counted (an overrun, [`super::Sample::late`]). A burst would
+//! pair stale samples with fresh drive phases and starve the control tick behind them.
 
 /// Deadlines of a sample clock: `f` samples per `F` ticks, on the grid `t_0 + floor(k·F/f)`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,16 +89,34 @@ mod tests {
     /// embassy-time's tick rate in the firmware (its default, 1 MHz: firmware/Cargo.toml).
     const TICK_HZ: u64 = 1_000_000;
 
+    /// One sample on a whole-tick period of 100 ticks: the one due at `due` ran at `now`.
+    fn whole_tick_step(due: u64, now: u64) -> (u64, u64) {
+        SampleClock::new(due, 100, 1).advance(now)
+    }
+
+    #[test]
+    fn a_whole_tick_period_skips_missed_ticks_instead_of_bursting() {
+        // On time and a little late: the next boundary, nothing skipped.
+        assert_eq!(whole_tick_step(1000, 1000), (1100, 0));
+        assert_eq!(whole_tick_step(1000, 1099), (1100, 0));
+        // Exactly one period late: that boundary is now, so it is skipped.
+        assert_eq!(whole_tick_step(1000, 1100), (1200, 1));
+        // 2.5 periods late: ticks at 1100 and 1200 skipped, the next at 1300 is ahead.
+        assert_eq!(whole_tick_step(1000, 1250), (1300, 2));
+        // The deadline stays on the grid of `due` + k·period.
+        let (n, _) = whole_tick_step(1000, 98_765);
+        assert_eq!((n - 1000) % 100, 0);
+        assert!(n > 98_765 && n <= 98_865);
+    }
+
     #[test]
     fn a_rate_the_tick_divides_is_the_whole_tick_grid() {
-        // 10 kHz on 1 MHz: 100 ticks exactly, the grid of `next_due(_, _, 100)`.
+        // 10 kHz on 1 MHz: 100 ticks exactly, every deadline 100 ticks after the last.
         let mut c = SampleClock::new(1000, TICK_HZ, 10_000);
         let mut due = 1000;
         for _ in 0..1000 {
-            let (n, s) = c.advance(due);
-            let (m, t) = crate::station::next_due(due, due, 100);
-            assert_eq!((n, s), (m, t));
-            due = n;
+            assert_eq!(c.advance(due), (due + 100, 0));
+            due += 100;
         }
     }
 
@@ -128,7 +147,7 @@ mod tests {
     fn late_samples_are_skipped_onto_the_same_grid() {
         let mut c = SampleClock::new(500, TICK_HZ, 12_000);
         // Sample 0 ran 250 µs late: the deadlines at 583, 666 and 750 have passed (3 skipped,
-        // as `next_due` counts them), 833 is ahead.
+        // counted as skipped), 833 is ahead.
         let (t, skipped) = c.advance(750);
         assert_eq!((t, skipped), (500 + 333, 3));
         // The grid is unchanged: sample 10 is at floor(10·10^6/12 000) = 833 µs after 500.

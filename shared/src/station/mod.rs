@@ -203,7 +203,7 @@ pub struct RigLoop {
 }
 
 impl RigLoop {
-    /// A stopped rig on `cfg` (validated; [`crate::persist::load`] gives one), θd at
+    /// A stopped rig on `cfg` (validated; [`crate::persist::store::load`] gives one), θd at
     /// `theta_d0`, both clocks at `now_us`.
     pub fn new(
         cfg: RigConfig,
@@ -564,40 +564,4 @@ fn telemetry_ticks(period_ms: u16, cfg: &RigConfig) -> u32 {
     let ms = u64::from(period_ms.max(MIN_TELEMETRY_MS));
     let ticks = (ms * u64::from(cfg.control_hz)).div_ceil(1000);
     u32::try_from(ticks).unwrap_or(u32::MAX).max(1)
-}
-
-/// The sample clock's next deadline. A sample that was due at `due` ran at `now` (any clock's
-/// ticks, `period` per sample): the next is due one period after `due`, or — when that time
-/// has already passed — at the first period boundary still ahead, with the ticks in between
-/// skipped (returned as the second value) and never made up in a burst. A burst would pair
-/// stale samples with fresh drive phases and starve the control tick behind them; a skipped
-/// tick is an overrun ([`Sample::late`]).
-pub fn next_due(due: u64, now: u64, period: u64) -> (u64, u64) {
-    let period = period.max(1);
-    let next = due + period;
-    if now < next {
-        return (next, 0);
-    }
-    let skipped = (now - next) / period + 1;
-    (next + skipped * period, skipped)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn next_due_skips_missed_ticks_instead_of_bursting() {
-        // On time and a little late: the next boundary, nothing skipped.
-        assert_eq!(next_due(1000, 1000, 100), (1100, 0));
-        assert_eq!(next_due(1000, 1099, 100), (1100, 0));
-        // Exactly one period late: that boundary is now, so it is skipped.
-        assert_eq!(next_due(1000, 1100, 100), (1200, 1));
-        // 2.5 periods late: ticks at 1100 and 1200 skipped, the next at 1300 is ahead.
-        assert_eq!(next_due(1000, 1250, 100), (1300, 2));
-        // The deadline stays on the grid of `due` + k·period.
-        let (n, _) = next_due(1000, 98_765, 100);
-        assert_eq!((n - 1000) % 100, 0);
-        assert!(n > 98_765 && n <= 98_865);
-    }
 }
